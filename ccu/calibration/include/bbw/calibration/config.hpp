@@ -1,0 +1,56 @@
+// Calibrator settings. Plain struct; validate() names the field, value and rule it breaks.
+#pragma once
+
+#include <string>
+
+#include "bbw/calibration/curve.hpp"
+
+namespace bbw::calibration {
+
+enum class Mode { Paper, Robust };
+enum class ThresholdSpacing { Even, Geometric };
+// Which sample of the closest pair the distance rule drops (the paper's text is ambiguous).
+enum class DropRule { DropJ, DropJPlus1 };
+
+struct CalibratorConfig {
+  Mode mode = Mode::Robust;
+
+  int elements_M = 8;        // Maxwell-slip elements
+  int samples_L = 64;        // samples kept per cycle
+  int pf_points_N = 20;      // N + 1 principal fitting points
+  int start_lag_n0 = 10;     // cycle-start detector lag, samples
+  double delta_max_rev = 0.3;  // largest element threshold
+
+  double x_min_rev = 0.0;    // displacement range of the PF points and distance rule
+  double x_max_rev = 7.0;
+  double f_min_kN = 0.0;     // force range of the distance rule
+  double f_max_kN = 50.0;
+  double full_scale_kN = 40.0;  // for error in % of full scale
+
+  Curve initial_curve{};     // starting A, B, C, D
+
+  // Samples outside these are rejected and counted (corrupt, not physical).
+  double accept_position_min_rev = -2.0;
+  double accept_position_max_rev = 12.0;
+  double accept_force_min_kN = -10.0;
+  double accept_force_max_kN = 100.0;
+
+  DropRule drop_rule = DropRule::DropJ;
+
+  // Robust-mode choices (ignored in paper mode, which uses the paper's plain method).
+  bool scale_x = true;               // fit in x scaled to [-1, 1]
+  bool nonnegative_k = true;         // K_i >= 0 by non-negative least squares
+  double min_cycle_span_rev = 0.3;   // no update from a cycle narrower than this
+  ThresholdSpacing spacing = ThresholdSpacing::Geometric;
+  double geometric_ratio = 0.6;      // Delta_{i} = Delta_{i+1} * ratio (smallest first)
+  bool streaming_states = true;      // element states updated every sample, rows stored
+  double ridge = 1e-6;               // Tikhonov weight on the scaled problem
+  double max_fit_rms_kN = 1.0;       // reject a cycle fit whose residual RMS exceeds this
+
+  // Throws std::invalid_argument naming the field, its value and the rule.
+  void validate() const;
+};
+
+const char* to_string(Mode m);
+
+}  // namespace bbw::calibration
