@@ -4,12 +4,14 @@
 // not allocate. The same object runs per sample in the CCU, offline over a CSV and in tests.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <vector>
 
+#include "bbw/calibration/bounded_lsq.hpp"
 #include "bbw/calibration/config.hpp"
 #include "bbw/calibration/curve.hpp"
+#include "bbw/calibration/cycle_detector.hpp"
+#include "bbw/calibration/sample_store.hpp"
 
 namespace bbw::calibration {
 
@@ -23,25 +25,27 @@ struct Estimate {
   double force_kN = 0.0;        // f_hat = load cell minus estimated friction
   double friction_kN = 0.0;     // estimated key/keyway friction sum K_i Delta_i n_i
   double curve_force_kN = 0.0;  // A x^3 + B x^2 + C x + D at the sample's position
-  bool valid = false;           // false when the sample was rejected (NaN, out of range)
+  bool valid = false;           // false when the sample was rejected (NaN, out of range, time backwards)
   bool calibrated = false;      // true once at least one cycle fit was accepted
+  bool cycle_start = false;     // a new hysteresis cycle started at this sample
+  bool fit_accepted = false;    // a cycle-end fit was accepted at this sample
 };
 
 struct Stats {
   std::uint64_t samples_seen = 0;
-  std::uint64_t samples_rejected = 0;  // non-finite or out of the configured physical range
+  std::uint64_t samples_rejected = 0;  // non-finite, out of the configured range, time backwards
   std::uint64_t cycles_detected = 0;
   std::uint64_t fits_accepted = 0;
   std::uint64_t fits_rejected = 0;
   double first_fit_time_s = -1.0;      // time of the first accepted fit; -1 before it
-  double last_fit_rms_kN = 0.0;        // residual RMS of the last accepted cycle fit
+  double last_fit_rms_kN = 0.0;        // residual RMS of the last cycle fit
   double last_fit_span_rev = 0.0;      // displacement span of the last cycle fitted
 };
 
-// Friction part of the model: thresholds and fitted stiffnesses (K_i in kN/rev).
+// Friction part of the model: thresholds Delta_i (rev) and stiffnesses K_i (kN/rev).
 struct FrictionParams {
-  std::vector<double> delta_rev;        // Delta_i
-  std::vector<double> stiffness_kN_per_rev;  // K_i
+  std::vector<double> delta_rev;
+  std::vector<double> stiffness_kN_per_rev;
 };
 
 class Calibrator {
@@ -55,55 +59,64 @@ class Calibrator {
   const FrictionParams& friction() const { return friction_; }
   const Stats& stats() const { return stats_; }
   const CalibratorConfig& config() const { return config_; }
-  // PF points' force coordinates (N + 1 of them) at X_k = Xmin + k (Xmax - Xmin) / N.
-  const std::vector<double>& pf_forces_kN() const { return pf_force_kN_; }
+  // PF points: X_k = Xmin + k (Xmax - Xmin) / N and their force coordinates.
+  const std::vector<double>& pf_positions_rev() const { return pf_x_rev_; }
+  const std::vector<double>& pf_forces_kN() const { return pf_f_kN_; }
 
-  // Restart from a known curve (e.g. a restarted corner's last good curve). Keeps stats.
+  // Restart from a known curve (e.g. a restarted corner's last good curve). Keeps stats and K_i.
   void reset_curve(const Curve& curve);
+  // Friction stiffnesses from elsewhere (e.g. the last good state); sizes must match M.
+  void set_friction_stiffness(const std::vector<double>& k_kN_per_rev);
 
   // Bytes owned by this object (itself plus its buffers), for the memory budget.
   std::size_t state_bytes() const;
 
  private:
-  struct Slot;
   void start_cycle(double x_rev);
-  void end_cycle(double time_s);
-  void store(const Sample& s);
-  double friction_now() const;
-  void step_elements(double x_rev);
-  bool fit_cycle(Curve& local, std::vector<double>& k_out);
-  void refit_global();
+  bool end_cycle();
+  void refit_curve_from_pf();
+  void regressor_row(double x_rev, const double* n, double* row) const;
+  double poly_basis_x(double x_rev, int power) const;
 
   CalibratorConfig config_;
+  bool robust_;
+  bool streaming_;
+  bool scaled_;
+  bool nonneg_;
+  int m_;      // elements
+  int p_;      // parameters per fit: 4 + M
+  double xc_rev_, xh_rev_;  // scaling x_s = (x - xc) / xh
+
   Curve curve_;
   FrictionParams friction_;
   Stats stats_;
-  std::vector<double> pf_force_kN_;
+  std::vector<double> phi_kN_;    // K_i Delta_i, the friction amplitude of element i
+  std::vector<double> pf_x_rev_;
+  std::vector<double> pf_f_kN_;
+  std::vector<double> pf_proj_;   // 4 x (N+1): PF forces -> scaled cubic coefficients
 
-  // Cycle detector history (ring of 2 n0 + 1 positions).
-  std::vector<double> history_rev_;
-  std::size_t history_head_ = 0;
-  std::uint64_t history_count_ = 0;
+  CycleDetector detector_;
+  SampleStore store_;
   bool in_cycle_ = false;
   std::uint64_t samples_since_start_ = 0;
+  double last_time_s_ = 0.0;
+  bool have_time_ = false;
 
-  // Element states: x_i positions for the live (streaming) model.
-  std::vector<double> element_pos_rev_;
-  std::vector<double> cycle_start_pos_rev_;  // x0_i at the current cycle's start
-
-  // Bounded store: L + 1 slots of (x, f, n_1..n_M), flattened.
-  std::vector<double> store_x_rev_;
-  std::vector<double> store_f_kN_;
-  std::vector<double> store_n_;  // (L + 1) * M
-  std::vector<double> dist_;     // L distances between consecutive slots
-  std::size_t store_count_ = 0;
+  std::vector<double> element_pos_rev_;  // live element positions x_i
+  std::vector<double> n_now_;            // live n_i
+  std::vector<double> start_pos_rev_;    // x0_i at the current cycle's start (replay)
 
   // Fit workspace, sized at construction.
-  std::vector<double> work_a_;  // design matrix rows
-  std::vector<double> work_b_;
-  std::vector<double> work_x_;
-  std::vector<double> work_tmp_;
-  std::vector<double> replay_pos_;
+  BoundedLeastSquares solver_;
+  std::vector<double> gram_;
+  std::vector<double> rhs_;
+  std::vector<double> theta_;
+  std::vector<double> row_;
+  std::vector<double> n_replay_;
+  std::vector<double> pos_replay_;
+  std::vector<char> column_on_;
+  std::vector<int> column_map_;
+  std::vector<char> nonneg_flags_;
 };
 
 }  // namespace bbw::calibration

@@ -1,0 +1,375 @@
+#include "bbw/calibration/calibrator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "bbw/calibration/maxwell_slip.hpp"
+
+namespace bbw::calibration {
+
+namespace {
+
+constexpr int kCurveTerms = 4;
+
+// Solves the 4 x 4 normal equations of a cubic fit to the PF points once, at construction:
+// proj (4 x (N+1)) maps PF forces to coefficients of the cubic in u = (X - xc) / xh.
+std::vector<double> pf_projection(const std::vector<double>& pf_x, double xc, double xh) {
+  const std::size_t n = pf_x.size();
+  double g[16] = {0};
+  std::vector<double> v(n * 4);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double u = (pf_x[k] - xc) / xh;
+    double p = 1.0;
+    for (int m = 0; m < 4; ++m) {
+      v[k * 4 + static_cast<std::size_t>(m)] = p;
+      p *= u;
+    }
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) g[r * 4 + c] += v[k * 4 + static_cast<std::size_t>(r)] * v[k * 4 + static_cast<std::size_t>(c)];
+    }
+  }
+  // Invert g (SPD, 4 x 4) by Gauss-Jordan.
+  double inv[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  for (int c = 0; c < 4; ++c) {
+    int piv = c;
+    for (int r = c + 1; r < 4; ++r) {
+      if (std::fabs(g[r * 4 + c]) > std::fabs(g[piv * 4 + c])) piv = r;
+    }
+    for (int k = 0; k < 4; ++k) {
+      std::swap(g[c * 4 + k], g[piv * 4 + k]);
+      std::swap(inv[c * 4 + k], inv[piv * 4 + k]);
+    }
+    const double d = g[c * 4 + c];
+    if (std::fabs(d) < 1e-300) throw std::invalid_argument("pf_points_N too small to fit a cubic");
+    for (int k = 0; k < 4; ++k) {
+      g[c * 4 + k] /= d;
+      inv[c * 4 + k] /= d;
+    }
+    for (int r = 0; r < 4; ++r) {
+      if (r == c) continue;
+      const double f = g[r * 4 + c];
+      for (int k = 0; k < 4; ++k) {
+        g[r * 4 + k] -= f * g[c * 4 + k];
+        inv[r * 4 + k] -= f * inv[c * 4 + k];
+      }
+    }
+  }
+  std::vector<double> proj(4 * n, 0.0);
+  for (int r = 0; r < 4; ++r) {
+    for (std::size_t k = 0; k < n; ++k) {
+      double s = 0.0;
+      for (int c = 0; c < 4; ++c) s += inv[r * 4 + c] * v[k * 4 + static_cast<std::size_t>(c)];
+      proj[static_cast<std::size_t>(r) * n + k] = s;
+    }
+  }
+  return proj;
+}
+
+// Cubic in u = (x - xc) / xh -> raw coefficients.
+Curve raw_from_scaled(const double c[4], double xc, double xh) {
+  const double s = 1.0 / xh;
+  const double t = -xc / xh;
+  Curve out;
+  out.a = c[3] * s * s * s;
+  out.b = c[2] * s * s + 3.0 * c[3] * s * s * t;
+  out.c = c[1] * s + 2.0 * c[2] * s * t + 3.0 * c[3] * s * t * t;
+  out.d = c[0] + c[1] * t + c[2] * t * t + c[3] * t * t * t;
+  return out;
+}
+
+}  // namespace
+
+Calibrator::Calibrator(const CalibratorConfig& config)
+    : config_((config.validate(), config)),
+      robust_(config.mode == Mode::Robust),
+      streaming_(robust_ && config.streaming_states),
+      scaled_(robust_ && config.scale_x),
+      nonneg_(robust_ && config.nonnegative_k),
+      m_(config.elements_M),
+      p_(kCurveTerms + config.elements_M),
+      xc_rev_(0.5 * (config.x_max_rev + config.x_min_rev)),
+      xh_rev_(0.5 * (config.x_max_rev - config.x_min_rev)),
+      curve_(config.initial_curve),
+      detector_(config.start_lag_n0, robust_ ? config.start_margin_rev : 0.0),
+      store_(config.samples_L, config.elements_M, config.x_max_rev - config.x_min_rev,
+             config.f_max_kN - config.f_min_kN, config.drop_rule),
+      solver_(kCurveTerms + config.elements_M) {
+  const auto m = static_cast<std::size_t>(m_);
+  const auto p = static_cast<std::size_t>(p_);
+  friction_.delta_rev.assign(m, 0.0);
+  const bool geometric = robust_ && config.spacing == ThresholdSpacing::Geometric;
+  thresholds(m, config.delta_max_rev, geometric, config.geometric_ratio, friction_.delta_rev.data());
+  friction_.stiffness_kN_per_rev.assign(m, 0.0);
+  phi_kN_.assign(m, 0.0);
+
+  const auto n_pf = static_cast<std::size_t>(config.pf_points_N) + 1;
+  pf_x_rev_.resize(n_pf);
+  pf_f_kN_.resize(n_pf);
+  for (std::size_t k = 0; k < n_pf; ++k) {
+    pf_x_rev_[k] = config.x_min_rev + static_cast<double>(k) * (config.x_max_rev - config.x_min_rev) /
+                                          static_cast<double>(config.pf_points_N);
+  }
+  pf_proj_ = pf_projection(pf_x_rev_, xc_rev_, xh_rev_);
+  for (std::size_t k = 0; k < n_pf; ++k) pf_f_kN_[k] = curve_.force_kN(pf_x_rev_[k]);
+
+  element_pos_rev_.assign(m, 0.0);
+  n_now_.assign(m, 0.0);
+  start_pos_rev_.assign(m, 0.0);
+  gram_.assign(p * p, 0.0);
+  rhs_.assign(p, 0.0);
+  theta_.assign(p, 0.0);
+  row_.assign(p, 0.0);
+  n_replay_.assign(m, 0.0);
+  pos_replay_.assign(m, 0.0);
+  column_on_.assign(p, 1);
+  column_map_.assign(p, 0);
+  nonneg_flags_.assign(p, 0);
+}
+
+std::size_t Calibrator::state_bytes() const {
+  auto vb = [](const auto& v) { return v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type); };
+  return sizeof(*this) + vb(friction_.delta_rev) + vb(friction_.stiffness_kN_per_rev) + vb(phi_kN_) +
+         vb(pf_x_rev_) + vb(pf_f_kN_) + vb(pf_proj_) + (store_.bytes() - sizeof(store_)) +
+         (solver_.bytes() - sizeof(solver_)) + vb(element_pos_rev_) + vb(n_now_) + vb(start_pos_rev_) +
+         vb(gram_) + vb(rhs_) + vb(theta_) + vb(row_) + vb(n_replay_) + vb(pos_replay_) + vb(column_on_) +
+         vb(column_map_) + vb(nonneg_flags_) + static_cast<std::size_t>(2 * config_.start_lag_n0 + 1) * sizeof(double);
+}
+
+void Calibrator::reset_curve(const Curve& curve) {
+  curve_ = curve;
+  for (std::size_t k = 0; k < pf_x_rev_.size(); ++k) pf_f_kN_[k] = curve_.force_kN(pf_x_rev_[k]);
+}
+
+void Calibrator::set_friction_stiffness(const std::vector<double>& k_kN_per_rev) {
+  if (k_kN_per_rev.size() != phi_kN_.size()) {
+    throw std::invalid_argument("set_friction_stiffness: expected " + std::to_string(phi_kN_.size()) +
+                                " stiffnesses, got " + std::to_string(k_kN_per_rev.size()));
+  }
+  for (std::size_t i = 0; i < phi_kN_.size(); ++i) {
+    friction_.stiffness_kN_per_rev[i] = k_kN_per_rev[i];
+    phi_kN_[i] = k_kN_per_rev[i] * friction_.delta_rev[i];
+  }
+}
+
+double Calibrator::poly_basis_x(double x_rev, int power) const {
+  const double u = scaled_ ? (x_rev - xc_rev_) / xh_rev_ : x_rev;
+  double v = 1.0;
+  for (int k = 0; k < power; ++k) v *= u;
+  return v;
+}
+
+// Row of the eq. 5 regression. Robust: [1, u, u^2, u^3, n_1..n_M] (parameters: the cubic
+// deviation from the current curve in u, and phi_i = K_i Delta_i). Paper: [1, x, x^2, x^3,
+// Delta_i n_i] (parameters D, C, B, A, K_i).
+void Calibrator::regressor_row(double x_rev, const double* n, double* row) const {
+  const double u = scaled_ ? (x_rev - xc_rev_) / xh_rev_ : x_rev;
+  row[0] = 1.0;
+  row[1] = u;
+  row[2] = u * u;
+  row[3] = u * u * u;
+  for (int i = 0; i < m_; ++i) {
+    row[kCurveTerms + i] = robust_ ? n[i] : friction_.delta_rev[static_cast<std::size_t>(i)] * n[i];
+  }
+}
+
+void Calibrator::start_cycle(double x_rev) {
+  store_.clear();
+  in_cycle_ = true;
+  samples_since_start_ = 0;
+  ++stats_.cycles_detected;
+  for (int i = 0; i < m_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    // At a start all elements were slipping downwards: x0_i = x(start) + Delta_i.
+    start_pos_rev_[k] = x_rev + friction_.delta_rev[k];
+    if (!streaming_) element_pos_rev_[k] = start_pos_rev_[k];
+  }
+}
+
+bool Calibrator::end_cycle() {
+  const std::size_t rows = store_.size();
+  const double x_lo = store_.min_x_rev();
+  const double x_hi = store_.max_x_rev();
+  const double span = x_hi - x_lo;
+  stats_.last_fit_span_rev = span;
+
+  // Which columns take part: curve terms always; element i only when the cycle swept it
+  // through both of its slip states (span >= 2 Delta_i), else it keeps its previous value.
+  int p_on = 0;
+  for (int j = 0; j < p_; ++j) {
+    bool on = true;
+    if (j >= kCurveTerms && robust_ && config_.identify_per_element) {
+      on = span >= 2.0 * friction_.delta_rev[static_cast<std::size_t>(j - kCurveTerms)];
+    }
+    column_on_[static_cast<std::size_t>(j)] = on ? 1 : 0;
+    if (on) {
+      column_map_[static_cast<std::size_t>(p_on)] = j;
+      nonneg_flags_[static_cast<std::size_t>(p_on)] = (nonneg_ && j >= kCurveTerms) ? 1 : 0;
+      ++p_on;
+    }
+  }
+  if (rows < static_cast<std::size_t>(p_on) + 2) return false;
+
+  std::fill(gram_.begin(), gram_.end(), 0.0);
+  std::fill(rhs_.begin(), rhs_.end(), 0.0);
+  for (int i = 0; i < m_; ++i) pos_replay_[static_cast<std::size_t>(i)] = start_pos_rev_[static_cast<std::size_t>(i)];
+  double* row = row_.data();
+  const auto pu = static_cast<std::size_t>(p_on);
+  for (std::size_t r = 0; r < rows; ++r) {
+    const double x = store_.x_rev(r);
+    const double* n = store_.n_row(r);
+    if (!streaming_) {
+      // The paper's flowchart: replay the elements from x0_i over the stored samples.
+      elements_step(x, friction_.delta_rev.data(), pos_replay_.data(), static_cast<std::size_t>(m_), nullptr,
+                    n_replay_.data());
+      n = n_replay_.data();
+    }
+    double full[64 + kCurveTerms];
+    regressor_row(x, n, full);
+    double b = store_.f_kN(r);
+    if (robust_) {
+      b -= curve_.force_kN(x);
+      for (int i = 0; i < m_; ++i) {
+        if (!column_on_[static_cast<std::size_t>(kCurveTerms + i)]) b -= phi_kN_[static_cast<std::size_t>(i)] * n[i];
+      }
+    }
+    for (std::size_t a = 0; a < pu; ++a) row[a] = full[column_map_[a]];
+    for (std::size_t a = 0; a < pu; ++a) {
+      rhs_[a] += row[a] * b;
+      for (std::size_t c = a; c < pu; ++c) gram_[a * pu + c] += row[a] * row[c];
+    }
+  }
+  for (std::size_t a = 0; a < pu; ++a) {
+    for (std::size_t c = 0; c < a; ++c) gram_[a * pu + c] = gram_[c * pu + a];
+  }
+  bool ok;
+  if (robust_) {
+    const double lambda = config_.ridge * static_cast<double>(rows);
+    for (std::size_t a = 0; a < pu; ++a) gram_[a * pu + a] += lambda;
+    ok = solver_.solve(gram_.data(), rhs_.data(), nonneg_flags_.data(), p_on, theta_.data());
+  } else {
+    ok = solver_.solve_unbounded(gram_.data(), rhs_.data(), p_on, theta_.data());
+  }
+  if (!ok) return false;
+  for (std::size_t a = 0; a < pu; ++a) {
+    if (!std::isfinite(theta_[a])) return false;
+  }
+
+  // Residual RMS of the fit, from the normal equations: |b|^2 - 2 t'h + t'G t is unstable;
+  // recompute directly instead (rows <= L, cheap).
+  for (int i = 0; i < m_; ++i) pos_replay_[static_cast<std::size_t>(i)] = start_pos_rev_[static_cast<std::size_t>(i)];
+  double sse = 0.0;
+  for (std::size_t r = 0; r < rows; ++r) {
+    const double x = store_.x_rev(r);
+    const double* n = store_.n_row(r);
+    if (!streaming_) {
+      elements_step(x, friction_.delta_rev.data(), pos_replay_.data(), static_cast<std::size_t>(m_), nullptr,
+                    n_replay_.data());
+      n = n_replay_.data();
+    }
+    double full[64 + kCurveTerms];
+    regressor_row(x, n, full);
+    double model = 0.0;
+    for (std::size_t a = 0; a < pu; ++a) model += full[column_map_[a]] * theta_[a];
+    double b = store_.f_kN(r);
+    if (robust_) {
+      b -= curve_.force_kN(x);
+      for (int i = 0; i < m_; ++i) {
+        if (!column_on_[static_cast<std::size_t>(kCurveTerms + i)]) b -= phi_kN_[static_cast<std::size_t>(i)] * n[i];
+      }
+    }
+    sse += (b - model) * (b - model);
+  }
+  const double rms = std::sqrt(sse / static_cast<double>(rows));
+  stats_.last_fit_rms_kN = rms;
+  if (robust_ && rms > config_.max_fit_rms_kN) return false;
+
+  // Curve terms (first four of theta, always on).
+  const double c0 = theta_[0], c1 = theta_[1], c2 = theta_[2], c3 = theta_[3];
+  const bool update_curve = !robust_ || span >= config_.min_cycle_span_rev;
+  if (update_curve) {
+    for (std::size_t k = 0; k < pf_x_rev_.size(); ++k) {
+      const double X = pf_x_rev_[k];
+      if (X < x_lo || X > x_hi) continue;
+      const double u = scaled_ ? (X - xc_rev_) / xh_rev_ : X;
+      const double local = ((c3 * u + c2) * u + c1) * u + c0;
+      pf_f_kN_[k] = robust_ ? curve_.force_kN(X) + local : local;
+    }
+    refit_curve_from_pf();
+  }
+  // Friction amplitudes.
+  for (std::size_t a = kCurveTerms; a < pu; ++a) {
+    const auto i = static_cast<std::size_t>(column_map_[a] - kCurveTerms);
+    const double phi_new = robust_ ? theta_[a] : theta_[a] * friction_.delta_rev[i];
+    const double w = (robust_ && stats_.fits_accepted > 0) ? config_.k_smoothing : 1.0;
+    phi_kN_[i] = (1.0 - w) * phi_kN_[i] + w * phi_new;
+    friction_.stiffness_kN_per_rev[i] = phi_kN_[i] / friction_.delta_rev[i];
+  }
+  return true;
+}
+
+void Calibrator::refit_curve_from_pf() {
+  const std::size_t n = pf_x_rev_.size();
+  double c[4];
+  for (std::size_t r = 0; r < 4; ++r) {
+    double s = 0.0;
+    for (std::size_t k = 0; k < n; ++k) s += pf_proj_[r * n + k] * pf_f_kN_[k];
+    c[r] = s;
+  }
+  curve_ = raw_from_scaled(c, xc_rev_, xh_rev_);
+}
+
+Estimate Calibrator::update(const Sample& s) {
+  Estimate e;
+  ++stats_.samples_seen;
+  const bool finite = std::isfinite(s.time_s) && std::isfinite(s.position_rev) && std::isfinite(s.force_kN);
+  const bool in_range = finite && s.position_rev >= config_.accept_position_min_rev &&
+                        s.position_rev <= config_.accept_position_max_rev &&
+                        s.force_kN >= config_.accept_force_min_kN && s.force_kN <= config_.accept_force_max_kN;
+  const bool time_ok = finite && (!have_time_ || s.time_s > last_time_s_);
+  if (!in_range || !time_ok) {
+    ++stats_.samples_rejected;
+    e.valid = false;
+    e.calibrated = stats_.fits_accepted > 0;
+    return e;
+  }
+  last_time_s_ = s.time_s;
+  have_time_ = true;
+  const double x = s.position_rev;
+
+  const bool start = detector_.update(x);
+  if (start && (!in_cycle_ || samples_since_start_ >= static_cast<std::uint64_t>(config_.samples_L))) {
+    if (in_cycle_) {
+      if (end_cycle()) {
+        ++stats_.fits_accepted;
+        if (stats_.first_fit_time_s < 0.0) stats_.first_fit_time_s = s.time_s;
+        e.fit_accepted = true;
+      } else {
+        ++stats_.fits_rejected;
+      }
+    }
+    start_cycle(x);
+    e.cycle_start = true;
+  }
+
+  // Live element states and the friction estimate for this sample.
+  const double friction = elements_step(x, friction_.delta_rev.data(), element_pos_rev_.data(),
+                                        static_cast<std::size_t>(m_), nullptr, n_now_.data());
+  (void)friction;
+  double f_fric = 0.0;
+  for (int i = 0; i < m_; ++i) f_fric += phi_kN_[static_cast<std::size_t>(i)] * n_now_[static_cast<std::size_t>(i)];
+
+  if (in_cycle_) {
+    store_.add(x, s.force_kN, n_now_.data());
+    ++samples_since_start_;
+  }
+
+  e.valid = true;
+  e.friction_kN = f_fric;
+  e.force_kN = s.force_kN - f_fric;
+  e.curve_force_kN = curve_.force_kN(x);
+  e.calibrated = stats_.fits_accepted > 0;
+  return e;
+}
+
+}  // namespace bbw::calibration

@@ -1,0 +1,48 @@
+#include "bbw/calibration/config.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace bbw::calibration {
+
+namespace {
+
+[[noreturn]] void bad(const char* field, double value, const char* rule) {
+  std::ostringstream os;
+  os << "calibrator config: " << field << " = " << value << ": " << rule;
+  throw std::invalid_argument(os.str());
+}
+
+}  // namespace
+
+const char* to_string(Mode m) { return m == Mode::Paper ? "paper" : "robust"; }
+
+void CalibratorConfig::validate() const {
+  if (elements_M < 1 || elements_M > 64) bad("elements_M", elements_M, "must be in [1, 64]");
+  if (samples_L < 2 * (4 + elements_M) || samples_L > 4096) {
+    bad("samples_L", samples_L, "must be in [2 (4 + elements_M), 4096]");
+  }
+  if (pf_points_N < 3 || pf_points_N > 1000) bad("pf_points_N", pf_points_N, "must be in [3, 1000]");
+  if (start_lag_n0 < 1 || start_lag_n0 > 10000) bad("start_lag_n0", start_lag_n0, "must be in [1, 10000]");
+  if (!(delta_max_rev > 0.0) || !std::isfinite(delta_max_rev)) bad("delta_max_rev", delta_max_rev, "must be > 0");
+  if (!(x_max_rev > x_min_rev)) bad("x_max_rev", x_max_rev, "must be > x_min_rev");
+  if (!(f_max_kN > f_min_kN)) bad("f_max_kN", f_max_kN, "must be > f_min_kN");
+  if (!(full_scale_kN > 0.0)) bad("full_scale_kN", full_scale_kN, "must be > 0");
+  if (!(accept_position_max_rev > accept_position_min_rev)) {
+    bad("accept_position_max_rev", accept_position_max_rev, "must be > accept_position_min_rev");
+  }
+  if (!(accept_force_max_kN > accept_force_min_kN)) bad("accept_force_max_kN", accept_force_max_kN, "must be > accept_force_min_kN");
+  if (!std::isfinite(initial_curve.a) || !std::isfinite(initial_curve.b) || !std::isfinite(initial_curve.c) ||
+      !std::isfinite(initial_curve.d)) {
+    bad("initial_curve", 0.0, "coefficients must be finite");
+  }
+  if (!(min_cycle_span_rev >= 0.0)) bad("min_cycle_span_rev", min_cycle_span_rev, "must be >= 0");
+  if (!(geometric_ratio > 0.0 && geometric_ratio < 1.0)) bad("geometric_ratio", geometric_ratio, "must be in (0, 1)");
+  if (!(ridge >= 0.0)) bad("ridge", ridge, "must be >= 0");
+  if (!(max_fit_rms_kN > 0.0)) bad("max_fit_rms_kN", max_fit_rms_kN, "must be > 0");
+  if (!(start_margin_rev >= 0.0)) bad("start_margin_rev", start_margin_rev, "must be >= 0");
+  if (!(k_smoothing > 0.0 && k_smoothing <= 1.0)) bad("k_smoothing", k_smoothing, "must be in (0, 1]");
+}
+
+}  // namespace bbw::calibration

@@ -1,0 +1,78 @@
+#include "bbw/calibration/config_yaml.hpp"
+
+#include <stdexcept>
+
+namespace bbw::calibration {
+
+using bbw::config::Range;
+using bbw::config::Reader;
+
+CalibratorConfig read_config(Reader& r) {
+  CalibratorConfig c;
+  c.mode = r.choice("mode", {"paper", "robust"}) == "paper" ? Mode::Paper : Mode::Robust;
+  c.elements_M = static_cast<int>(r.integer("elements_M", 1, 64));
+  c.samples_L = static_cast<int>(r.integer("samples_L", 2, 4096));
+  c.pf_points_N = static_cast<int>(r.integer("pf_points_N", 3, 1000));
+  c.start_lag_n0 = static_cast<int>(r.integer("start_lag_n0", 1, 10000));
+  c.delta_max_rev = r.number("delta_max_rev", Range::positive());
+  auto range = r.map("range");
+  c.x_min_rev = range.number("x_min_rev");
+  c.x_max_rev = range.number("x_max_rev");
+  c.f_min_kN = range.number("f_min_kN");
+  c.f_max_kN = range.number("f_max_kN");
+  c.full_scale_kN = range.number_or("full_scale_kN", 40.0, Range::positive());
+  range.finish();
+  if (!(c.x_max_rev > c.x_min_rev)) range.fail("x_max_rev", "must be > range.x_min_rev");
+  if (!(c.f_max_kN > c.f_min_kN)) range.fail("f_max_kN", "must be > range.f_min_kN");
+
+  auto curve = r.map("initial_curve");
+  c.initial_curve.a = curve.number("a_kN_per_rev3");
+  c.initial_curve.b = curve.number("b_kN_per_rev2");
+  c.initial_curve.c = curve.number("c_kN_per_rev");
+  c.initial_curve.d = curve.number("d_kN");
+  curve.finish();
+
+  if (auto acc = r.optional_map("accept")) {
+    c.accept_position_min_rev = acc->number_or("position_min_rev", c.accept_position_min_rev);
+    c.accept_position_max_rev = acc->number_or("position_max_rev", c.accept_position_max_rev);
+    c.accept_force_min_kN = acc->number_or("force_min_kN", c.accept_force_min_kN);
+    c.accept_force_max_kN = acc->number_or("force_max_kN", c.accept_force_max_kN);
+    acc->finish();
+    if (!(c.accept_position_max_rev > c.accept_position_min_rev)) acc->fail("position_max_rev", "must be > position_min_rev");
+    if (!(c.accept_force_max_kN > c.accept_force_min_kN)) acc->fail("force_max_kN", "must be > force_min_kN");
+  }
+  c.drop_rule = r.choice_or("drop_rule", "j", {"j", "j_plus_1"}) == "j" ? DropRule::DropJ : DropRule::DropJPlus1;
+
+  if (auto rb = r.optional_map("robust")) {
+    c.scale_x = rb->boolean_or("scale_x", c.scale_x);
+    c.nonnegative_k = rb->boolean_or("nonnegative_k", c.nonnegative_k);
+    c.min_cycle_span_rev = rb->number_or("min_cycle_span_rev", c.min_cycle_span_rev, Range::non_negative());
+    c.spacing = rb->choice_or("spacing", c.spacing == ThresholdSpacing::Geometric ? "geometric" : "even",
+                              {"even", "geometric"}) == "geometric"
+                    ? ThresholdSpacing::Geometric
+                    : ThresholdSpacing::Even;
+    c.geometric_ratio = rb->number_or("geometric_ratio", c.geometric_ratio, Range{0.0, 1.0, true, true});
+    c.streaming_states = rb->boolean_or("streaming_states", c.streaming_states);
+    c.ridge = rb->number_or("ridge", c.ridge, Range::non_negative());
+    c.max_fit_rms_kN = rb->number_or("max_fit_rms_kN", c.max_fit_rms_kN, Range::positive());
+    c.start_margin_rev = rb->number_or("start_margin_rev", c.start_margin_rev, Range::non_negative());
+    c.k_smoothing = rb->number_or("k_smoothing", c.k_smoothing, Range{0.0, 1.0, true, false});
+    c.identify_per_element = rb->boolean_or("identify_per_element", c.identify_per_element);
+    rb->finish();
+  }
+  try {
+    c.validate();
+  } catch (const std::invalid_argument& e) {
+    r.fail("", e.what());
+  }
+  return c;
+}
+
+CalibratorConfig load_config(const std::string& file) {
+  Reader r = Reader::from_file(file);
+  CalibratorConfig c = read_config(r);
+  r.finish();
+  return c;
+}
+
+}  // namespace bbw::calibration
