@@ -1,0 +1,84 @@
+// RAII owner of one DomainParticipant with its publisher, subscriber and topics.
+//
+// QoS comes from the XML profiles in config/dds/bbw_profiles.xml (or the file named by
+// ParticipantOptions::profiles_file / env BBW_DDS_PROFILES). Constructors throw DdsError when
+// an entity cannot be created; destructors release everything the object created.
+#pragma once
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/ContentFilteredTopic.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace bbw::dds {
+
+class DdsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Participant profile names in bbw_profiles.xml.
+inline constexpr const char* kLocalhostProfile = "bbw_localhost";  // SHM + UDPv4 on 127.0.0.1
+inline constexpr const char* kNetworkProfile = "bbw_network";      // explicit multi-host config
+
+struct ParticipantOptions {
+  int domain_id = 0;
+  std::string profiles_file;            // empty: default_profiles_file()
+  std::string profile = kLocalhostProfile;
+  std::string name;                     // participant name seen in discovery, e.g. "bbw_corner_FL"
+  // Extra participant properties appended to the profile's (e.g. DDS Security plugins, issue 7).
+  std::vector<std::pair<std::string, std::string>> properties;
+};
+
+// env BBW_DDS_PROFILES if set, else the file in the source tree this binary was built from.
+std::string default_profiles_file();
+
+// Loads an XML profiles file into the factory once per process (idempotent per path).
+// Throws DdsError naming the file when it is missing or malformed.
+void load_profiles(const std::string& file);
+
+class Participant {
+ public:
+  explicit Participant(const ParticipantOptions& options);
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+
+  eprosima::fastdds::dds::DomainParticipant& get() { return *participant_; }
+  eprosima::fastdds::dds::Publisher& publisher() { return *publisher_; }
+  eprosima::fastdds::dds::Subscriber& subscriber() { return *subscriber_; }
+  int domain_id() const { return domain_id_; }
+
+  // The topic `name` of type PubSubT (registered on first use), owned by this participant.
+  template <class PubSubT>
+  eprosima::fastdds::dds::Topic& topic(const std::string& name) {
+    eprosima::fastdds::dds::TypeSupport type(new PubSubT());
+    return topic_impl(name, type);
+  }
+
+  // A content-filtered view of `topic` (DDS-SQL expression, e.g. "corner_id = %0").
+  eprosima::fastdds::dds::ContentFilteredTopic& filtered_topic(
+      eprosima::fastdds::dds::Topic& topic, const std::string& name, const std::string& expression,
+      const std::vector<std::string>& parameters);
+
+ private:
+  eprosima::fastdds::dds::Topic& topic_impl(const std::string& name,
+                                            eprosima::fastdds::dds::TypeSupport type);
+
+  int domain_id_;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+  std::map<std::string, eprosima::fastdds::dds::ContentFilteredTopic*> filtered_;
+};
+
+}  // namespace bbw::dds

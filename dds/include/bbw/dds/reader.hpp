@@ -1,0 +1,133 @@
+// RAII typed DataReader: created from an XML data_reader profile, deleted in the destructor.
+// Data, matches and QoS events notify an Events object the owner waits on.
+#pragma once
+
+#include <fastdds/dds/core/status/StatusMask.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "bbw/dds/events.hpp"
+#include "bbw/dds/participant.hpp"
+
+namespace bbw::dds {
+
+// Optional content filter: only samples matching `expression` are delivered.
+struct ContentFilter {
+  std::string filtered_topic_name;  // unique per participant, e.g. "ClampCommand_FL"
+  std::string expression;           // DDS-SQL, e.g. "corner_id = %0"
+  std::vector<std::string> parameters;
+};
+
+template <class PubSubT>
+class Reader : private eprosima::fastdds::dds::DataReaderListener {
+ public:
+  using Type = typename PubSubT::type;
+
+  Reader(Participant& participant, const std::string& topic_name, const std::string& profile,
+         Events& events, const ContentFilter* filter = nullptr)
+      : participant_(participant), events_(events) {
+    auto& topic = participant.topic<PubSubT>(topic_name);
+    eprosima::fastdds::dds::TopicDescription* description = &topic;
+    if (filter != nullptr) {
+      description = &participant.filtered_topic(topic, filter->filtered_topic_name,
+                                                filter->expression, filter->parameters);
+    }
+    reader_ = participant.subscriber().create_datareader_with_profile(
+        description, profile, this, eprosima::fastdds::dds::StatusMask::all());
+    if (reader_ == nullptr) {
+      throw DdsError("cannot create DataReader on topic '" + topic_name + "' with profile '" +
+                     profile + "' (unknown profile or inconsistent QoS)");
+    }
+  }
+  ~Reader() override {
+    reader_->set_listener(nullptr);
+    participant_.subscriber().delete_datareader(reader_);
+  }
+  Reader(const Reader&) = delete;
+  Reader& operator=(const Reader&) = delete;
+
+  // Takes the next valid sample into `out`; false when none is waiting. Never blocks.
+  bool take(Type& out) {
+    eprosima::fastdds::dds::SampleInfo info;
+    while (reader_->take_next_sample(&out, &info) == ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data) {
+        taken_.fetch_add(1);
+        return true;
+      }
+    }
+    return false;
+  }
+
+  int matched() const { return matched_.load(); }
+  std::uint64_t taken() const { return taken_.load(); }
+  std::uint64_t deadlines_missed() const { return deadlines_missed_.load(); }
+  std::uint64_t liveliness_lost() const { return liveliness_lost_.load(); }  // alive -> not alive
+  int alive_writers() const { return alive_writers_.load(); }
+  std::uint64_t samples_lost() const { return samples_lost_.load(); }
+  std::uint64_t samples_rejected() const { return samples_rejected_.load(); }
+  std::uint64_t incompatible_qos() const { return incompatible_qos_.load(); }
+
+  bool wait_for_matched(int n, std::chrono::steady_clock::duration timeout) {
+    return events_.wait_for(timeout, [&] { return matched_.load() >= n; });
+  }
+
+  eprosima::fastdds::dds::DataReader& get() { return *reader_; }
+
+ private:
+  void on_data_available(eprosima::fastdds::dds::DataReader*) override { events_.notify(); }
+  void on_subscription_matched(eprosima::fastdds::dds::DataReader*,
+                               const eprosima::fastdds::dds::SubscriptionMatchedStatus& s) override {
+    matched_.store(s.current_count);
+    events_.notify();
+  }
+  void on_requested_deadline_missed(
+      eprosima::fastdds::dds::DataReader*,
+      const eprosima::fastdds::dds::RequestedDeadlineMissedStatus&) override {
+    deadlines_missed_.fetch_add(1);
+    events_.notify();
+  }
+  void on_liveliness_changed(eprosima::fastdds::dds::DataReader*,
+                             const eprosima::fastdds::dds::LivelinessChangedStatus& s) override {
+    alive_writers_.store(s.alive_count);
+    if (s.not_alive_count_change > 0) {
+      liveliness_lost_.fetch_add(static_cast<std::uint64_t>(s.not_alive_count_change));
+    }
+    events_.notify();
+  }
+  void on_sample_lost(eprosima::fastdds::dds::DataReader*,
+                      const eprosima::fastdds::dds::SampleLostStatus& s) override {
+    samples_lost_.fetch_add(static_cast<std::uint64_t>(s.total_count_change));
+    events_.notify();
+  }
+  void on_sample_rejected(eprosima::fastdds::dds::DataReader*,
+                          const eprosima::fastdds::dds::SampleRejectedStatus& s) override {
+    samples_rejected_.fetch_add(static_cast<std::uint64_t>(s.total_count_change));
+    events_.notify();
+  }
+  void on_requested_incompatible_qos(
+      eprosima::fastdds::dds::DataReader*,
+      const eprosima::fastdds::dds::RequestedIncompatibleQosStatus&) override {
+    incompatible_qos_.fetch_add(1);
+    events_.notify();
+  }
+
+  Participant& participant_;
+  Events& events_;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
+  std::atomic<int> matched_{0};
+  std::atomic<int> alive_writers_{0};
+  std::atomic<std::uint64_t> taken_{0};
+  std::atomic<std::uint64_t> deadlines_missed_{0};
+  std::atomic<std::uint64_t> liveliness_lost_{0};
+  std::atomic<std::uint64_t> samples_lost_{0};
+  std::atomic<std::uint64_t> samples_rejected_{0};
+  std::atomic<std::uint64_t> incompatible_qos_{0};
+};
+
+}  // namespace bbw::dds

@@ -1,0 +1,107 @@
+#include "bbw/dds/participant.hpp"
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <set>
+
+#ifndef BBW_DEFAULT_DDS_PROFILES
+#error "BBW_DEFAULT_DDS_PROFILES must be defined by dds/CMakeLists.txt"
+#endif
+
+namespace bbw::dds {
+
+namespace fdds = eprosima::fastdds::dds;
+
+std::string default_profiles_file() {
+  if (const char* env = std::getenv("BBW_DDS_PROFILES"); env != nullptr && *env != '\0') return env;
+  return BBW_DEFAULT_DDS_PROFILES;
+}
+
+void load_profiles(const std::string& file) {
+  static std::mutex mutex;
+  static std::set<std::string> loaded;
+  std::lock_guard<std::mutex> lock(mutex);
+  std::error_code ec;
+  const std::string key = std::filesystem::weakly_canonical(file, ec).string();
+  if (loaded.count(key) != 0) return;
+  if (!std::filesystem::is_regular_file(file)) {
+    throw DdsError("DDS profiles file '" + file + "' does not exist (set BBW_DDS_PROFILES or pass --dds-profiles)");
+  }
+  if (fdds::DomainParticipantFactory::get_instance()->load_XML_profiles_file(file) !=
+      ReturnCode_t::RETCODE_OK) {
+    throw DdsError("DDS profiles file '" + file + "' could not be parsed (see Fast DDS log above)");
+  }
+  loaded.insert(key);
+}
+
+Participant::Participant(const ParticipantOptions& options) : domain_id_(options.domain_id) {
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  const std::string file = options.profiles_file.empty() ? default_profiles_file() : options.profiles_file;
+  load_profiles(file);
+
+  // QoS read from the named profile (never from PARTICIPANT_QOS_DEFAULT, which ignores XML).
+  fdds::DomainParticipantQos qos;
+  if (factory->get_participant_qos_from_profile(options.profile, qos) != ReturnCode_t::RETCODE_OK) {
+    throw DdsError("participant profile '" + options.profile + "' not found in " + file);
+  }
+  if (!options.name.empty()) qos.name(options.name);
+  for (const auto& [key, value] : options.properties) {
+    qos.properties().properties().emplace_back(key, value);
+  }
+  participant_ = factory->create_participant(options.domain_id, qos);
+  if (participant_ == nullptr) {
+    throw DdsError("cannot create DomainParticipant on domain " + std::to_string(options.domain_id) +
+                   " with profile '" + options.profile + "'");
+  }
+  publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  if (publisher_ == nullptr || subscriber_ == nullptr) {
+    participant_->delete_contained_entities();
+    factory->delete_participant(participant_);
+    throw DdsError("cannot create publisher/subscriber on domain " + std::to_string(options.domain_id));
+  }
+}
+
+Participant::~Participant() {
+  // Writers and readers are owned (and deleted) by their RAII wrappers, which must not outlive
+  // this object; delete_contained_entities() releases whatever remains.
+  participant_->delete_contained_entities();
+  fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+fdds::Topic& Participant::topic_impl(const std::string& name, fdds::TypeSupport type) {
+  if (auto it = topics_.find(name); it != topics_.end()) {
+    if (it->second->get_type_name() != type.get_type_name()) {
+      throw DdsError("topic '" + name + "' already exists with type " + it->second->get_type_name());
+    }
+    return *it->second;
+  }
+  if (participant_->find_type(type.get_type_name()).empty()) {
+    if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
+      throw DdsError("cannot register type " + type.get_type_name());
+    }
+  }
+  fdds::Topic* topic = participant_->create_topic(name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
+  if (topic == nullptr) throw DdsError("cannot create topic '" + name + "'");
+  topics_.emplace(name, topic);
+  return *topic;
+}
+
+fdds::ContentFilteredTopic& Participant::filtered_topic(fdds::Topic& topic, const std::string& name,
+                                                        const std::string& expression,
+                                                        const std::vector<std::string>& parameters) {
+  if (auto it = filtered_.find(name); it != filtered_.end()) return *it->second;
+  fdds::ContentFilteredTopic* cft =
+      participant_->create_contentfilteredtopic(name, &topic, expression, parameters);
+  if (cft == nullptr) {
+    throw DdsError("cannot create content-filtered topic '" + name + "' with '" + expression + "'");
+  }
+  filtered_.emplace(name, cft);
+  return *cft;
+}
+
+}  // namespace bbw::dds

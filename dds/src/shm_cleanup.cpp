@@ -1,0 +1,95 @@
+#include "bbw/dds/shm_cleanup.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <system_error>
+
+namespace bbw::dds {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// Holds flock(LOCK_EX) on a file until destroyed; locked() false when someone else holds it.
+class ExclusiveProbe {
+ public:
+  explicit ExclusiveProbe(const fs::path& file) {
+    fd_ = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd_ >= 0 && ::flock(fd_, LOCK_EX | LOCK_NB) == 0) locked_ = true;
+  }
+  ~ExclusiveProbe() {
+    if (fd_ >= 0) ::close(fd_);  // closing releases the lock
+  }
+  ExclusiveProbe(const ExclusiveProbe&) = delete;
+  ExclusiveProbe& operator=(const ExclusiveProbe&) = delete;
+  bool locked() const { return locked_; }
+
+ private:
+  int fd_ = -1;
+  bool locked_ = false;
+};
+
+bool older_than(const fs::path& file, std::chrono::seconds min_age) {
+  std::error_code ec;
+  const auto mtime = fs::last_write_time(file, ec);
+  if (ec) return true;  // vanished meanwhile: nothing to protect
+  return fs::file_time_type::clock::now() - mtime >= min_age;
+}
+
+}  // namespace
+
+ShmCleanupReport cleanup_stale_shm(const std::string& dir, std::chrono::seconds min_age) {
+  ShmCleanupReport report;
+  // Group lock files by the resource they guard: base -> its lock files.
+  std::map<std::string, std::vector<std::string>> groups;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("fastrtps_", 0) != 0) continue;
+    for (const char* suffix : {"_el", "_sl"}) {
+      if (ends_with(name, suffix)) {
+        groups[name.substr(0, name.size() - 3)].push_back(name);
+      }
+    }
+  }
+  const fs::path root(dir);
+  for (const auto& [base, locks] : groups) {
+    // Stale only when every lock file of the resource can be locked exclusively by us.
+    std::vector<std::unique_ptr<ExclusiveProbe>> held;
+    bool live = false;
+    for (const auto& lock : locks) {
+      held.push_back(std::make_unique<ExclusiveProbe>(root / lock));
+      if (!held.back()->locked()) live = true;
+    }
+    if (live) {
+      ++report.kept_live;
+      continue;
+    }
+    bool young = false;
+    for (const auto& lock : locks) young = young || !older_than(root / lock, min_age);
+    if (fs::exists(root / base, ec)) young = young || !older_than(root / base, min_age);
+    if (young) {
+      ++report.kept_young;
+      continue;
+    }
+    // Remove the resource first, then its semaphore, then the lock files (still held by us).
+    for (const std::string& victim : {base, "sem." + base + "_mutex"}) {
+      if (fs::remove(root / victim, ec)) report.removed.push_back(victim);
+    }
+    for (const auto& lock : locks) {
+      if (fs::remove(root / lock, ec)) report.removed.push_back(lock);
+    }
+  }
+  return report;
+}
+
+}  // namespace bbw::dds
