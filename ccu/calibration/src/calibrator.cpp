@@ -288,9 +288,13 @@ bool Calibrator::end_cycle() {
   const double c0 = theta_[0], c1 = theta_[1], c2 = theta_[2], c3 = theta_[3];
   const bool update_curve = !robust_ || span >= config_.min_cycle_span_rev;
   if (update_curve) {
+    // Robust mode also updates a PF point within half a PF spacing outside the cycle's span:
+    // a start is detected a little after the turning point, so the range ends would otherwise
+    // never be refreshed.
+    const double margin = robust_ ? 0.5 * (config_.x_max_rev - config_.x_min_rev) / config_.pf_points_N : 0.0;
     for (std::size_t k = 0; k < pf_x_rev_.size(); ++k) {
       const double X = pf_x_rev_[k];
-      if (X < x_lo || X > x_hi) continue;
+      if (X < x_lo - margin || X > x_hi + margin) continue;
       const double u = scaled_ ? (X - xc_rev_) / xh_rev_ : X;
       const double local = ((c3 * u + c2) * u + c1) * u + c0;
       pf_f_kN_[k] = robust_ ? curve_.force_kN(X) + local : local;
@@ -333,11 +337,16 @@ Estimate Calibrator::update(const Sample& s) {
     e.calibrated = stats_.fits_accepted > 0;
     return e;
   }
+  const double x = s.position_rev;
+  if (!have_time_) {
+    first_x_rev_ = x;
+    for (auto& p : element_pos_rev_) p = x;
+  }
   last_time_s_ = s.time_s;
   have_time_ = true;
-  const double x = s.position_rev;
+  if (!states_known_) states_known_ = !streaming_ || std::fabs(x - first_x_rev_) >= config_.delta_max_rev;
 
-  const bool start = detector_.update(x);
+  const bool start = detector_.update(x) && states_known_;
   if (start && (!in_cycle_ || samples_since_start_ >= static_cast<std::uint64_t>(config_.samples_L))) {
     if (in_cycle_) {
       if (end_cycle()) {

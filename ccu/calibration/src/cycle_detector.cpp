@@ -16,6 +16,7 @@ void CycleDetector::reset() {
   count_ = 0;
   head_ = 0;
   was_true_ = false;
+  falling_ = true;
 }
 
 bool CycleDetector::update(double x_rev) {
@@ -23,6 +24,28 @@ bool CycleDetector::update(double x_rev) {
   head_ = (head_ + 1) % size;
   ring_[head_] = x_rev;
   ++count_;
+  if (margin_rev_ > 0.0) {
+    if (count_ == 1) {
+      extreme_rev_ = x_rev;
+      falling_ = true;
+      return false;
+    }
+    if (falling_) {
+      if (x_rev < extreme_rev_) extreme_rev_ = x_rev;
+      if (x_rev > extreme_rev_ + margin_rev_) {
+        falling_ = false;
+        extreme_rev_ = x_rev;
+        return true;
+      }
+    } else {
+      if (x_rev > extreme_rev_) extreme_rev_ = x_rev;
+      if (x_rev < extreme_rev_ - margin_rev_) {
+        falling_ = true;
+        extreme_rev_ = x_rev;
+      }
+    }
+    return false;
+  }
   if (count_ < size) return false;
   const std::size_t n0 = static_cast<std::size_t>(n0_);
   const double x_lag1 = ring_[(head_ + size - n0) % size];

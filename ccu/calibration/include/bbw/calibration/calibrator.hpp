@@ -101,6 +101,10 @@ class Calibrator {
   std::uint64_t samples_since_start_ = 0;
   double last_time_s_ = 0.0;
   bool have_time_ = false;
+  // Streaming element states are exact once x has moved Delta_max one way from the first
+  // sample (every element has then slipped); cycle starts before that are ignored.
+  double first_x_rev_ = 0.0;
+  bool states_known_ = false;
 
   std::vector<double> element_pos_rev_;  // live element positions x_i
   std::vector<double> n_now_;            // live n_i

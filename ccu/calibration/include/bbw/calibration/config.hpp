@@ -46,7 +46,7 @@ struct CalibratorConfig {
   bool streaming_states = true;      // element states updated every sample, rows stored
   double ridge = 1e-6;               // Tikhonov weight per stored row on the scaled problem
   double max_fit_rms_kN = 1.0;       // reject a cycle fit whose residual RMS exceeds this
-  double start_margin_rev = 0.0;     // eq. 6 with a margin against noise (0 = the paper's rule)
+  double start_margin_rev = 0.02;    // robust start detector hysteresis (0 = the paper's eq. 6)
   double k_smoothing = 1.0;          // weight of a new fit's friction stiffness (1 = replace)
   bool identify_per_element = true;  // update K_i only when the cycle span >= 2 Delta_i
 

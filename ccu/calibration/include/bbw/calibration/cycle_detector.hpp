@@ -1,7 +1,13 @@
-// Hysteresis-cycle start detection (eq. 6): a start is where x turns from falling to rising,
-//   x(i) > x(i - n0) + margin  and  x(i - n0) < x(i - 2 n0) - margin.
-// The detector fires on the first sample where the condition becomes true (edge-triggered);
-// margin = 0 is the paper's rule, a margin of a few noise sigmas is robust mode's.
+// Hysteresis-cycle start detection: a start is where x turns from falling to rising.
+//
+// margin = 0: the paper's rule (eq. 6), edge-triggered (fires on the first sample where
+//   x(i) > x(i - n0)  and  x(i - n0) < x(i - 2 n0)  becomes true).
+//   Near a slow, noisy minimum it can fire more than once; the calibrator's "at least L
+//   samples since the last start" rule absorbs that.
+// margin > 0: robust mode's turning-point detector with hysteresis: while falling it tracks the
+//   lowest x; it fires when x rises more than `margin` above it, then tracks the highest x and
+//   re-arms when x falls more than `margin` below that. Noise below the margin cannot fire it,
+//   however slow the turn; the price is a detection delay of the time to rise by `margin`.
 #pragma once
 
 #include <cstdint>
@@ -26,6 +32,8 @@ class CycleDetector {
   int n0_;
   double margin_rev_;
   bool was_true_ = false;
+  bool falling_ = true;       // hysteresis detector state
+  double extreme_rev_ = 0.0;  // running min (falling) or max (rising)
 };
 
 }  // namespace bbw::calibration

@@ -1,0 +1,53 @@
+// Counts heap allocations across a long per-sample run: there must be none after construction.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "bbw/calibration/calibrator.hpp"
+#include "synthetic.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}
+
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+using namespace bbw::calibration;
+
+TEST(CalibratorAllocation, NoHeapAllocationPerSample) {
+  for (Mode mode : {Mode::Robust, Mode::Paper}) {
+    CalibratorConfig c;
+    c.mode = mode;
+    c.elements_M = 8;
+    c.samples_L = 64;
+    c.x_min_rev = 0.5;
+    c.x_max_rev = 6.0;
+    c.f_max_kN = 40.0;
+    test::SyntheticTruth truth;
+    truth.delta_rev.assign(8, 0.0);
+    thresholds(8, c.delta_max_rev, mode == Mode::Robust, c.geometric_ratio, truth.delta_rev.data());
+    for (double d : truth.delta_rev) truth.k_kN_per_rev.push_back(0.1 / d);
+    const auto rec = test::synthetic_recording(truth, 0.03, 9);
+    Calibrator cal(c);
+    const long before = g_allocations.load();
+    double sink = 0.0;
+    for (std::size_t k = 0; k < rec.time_s.size(); ++k) {
+      sink += cal.update({rec.time_s[k], rec.position_rev[k], rec.force_kN[k]}).force_kN;
+    }
+    const long after = g_allocations.load();
+    EXPECT_EQ(after - before, 0) << "mode " << to_string(mode);
+    EXPECT_GE(cal.stats().fits_accepted, 8u);  // the run did exercise the cycle-end fits
+    EXPECT_TRUE(std::isfinite(sink));
+  }
+}
