@@ -1,0 +1,96 @@
+// The corner's local controller: a cascade of position (or clamp-force) loop -> speed loop ->
+// motor current command, with a current limit and anti-windup. Pure: time is an argument.
+//
+//   position mode: v_ref = v_ff + Kx (x_ref - x)                          (test rig)
+//   force mode:    v_ref = (wf e + wi * integral(e)) / k(F),  e = F_ref - F_fb,
+//                  k(F) = stiffness_at_zero + stiffness_per_kN * F      (vehicle)
+//                  below release_force_kN the controller returns to release_position_rev.
+//   speed loop:    i = Kv (v_ref - v) + Ki integral(v_ref - v) + i_load(F_load) + i_acc(a_ff)
+//   the command is clipped to +/- current_limit_A; integrators stop while clipped in the
+//   direction of the error (conditional integration).
+#pragma once
+
+namespace bbw::corner_unit {
+
+// Nominal actuator data the controller uses for feedforward (from the caliper's data sheet).
+struct ActuatorModel {
+  double torque_per_A_Nm = 0.27;      // at the spindle: kt * gear ratio * efficiency
+  double Nm_per_kN = 0.0398;          // spindle torque per kN of axial load: lead / 2 pi
+  double inertia_kg_m2 = 3.0e-3;      // reflected to the spindle
+};
+
+struct ControllerParams {
+  ActuatorModel actuator;
+  double current_limit_A = 40.0;
+  double position_gain_per_s = 40.0;
+  double speed_gain_A_per_rev_per_s = 14.0;
+  double speed_integral_gain_A_per_rev = 560.0;
+  double max_speed_rev_per_s = 25.0;
+  double force_bandwidth_rad_per_s = 30.0;
+  double force_integral_rad_per_s2 = 150.0;
+  double stiffness_at_zero_kN_per_rev = 2.5;
+  double stiffness_per_kN_per_rev = 0.3;       // (kN/rev) per kN
+  double release_force_kN = 0.1;
+  double release_position_rev = 0.0;
+  bool load_feedforward = true;
+
+  void validate() const;  // throws std::invalid_argument naming the field
+};
+
+// Where the force loop gets its feedback from.
+enum class ForceFeedback { LoadCell, Compensated, Curve, True };
+const char* to_string(ForceFeedback f);
+
+// The candidate force signals of one sample, kN.
+struct ForceSources {
+  double load_cell_kN = 0.0;           // raw internal load cell
+  double friction_estimate_kN = 0.0;   // the caller's estimate of the friction in it
+  double curve_estimate_kN = 0.0;      // the caller's curve evaluated at the measured position
+  double true_kN = 0.0;                // ground truth (simulation / external sensor)
+};
+double select_force(ForceFeedback f, const ForceSources& s);
+
+struct PositionReference {
+  double position_rev = 0.0;
+  double speed_rev_per_s = 0.0;        // feedforward; 0 if unknown
+  double accel_rev_per_s2 = 0.0;       // feedforward; 0 if unknown
+};
+
+struct ControllerInputs {
+  double position_rev = 0.0;           // resolver
+  double speed_rev_per_s = 0.0;        // resolver speed
+  double force_feedback_kN = 0.0;      // force-loop feedback (select_force)
+  double load_force_kN = 0.0;          // axial load for the current feedforward (load cell)
+};
+
+struct ControllerState {
+  double speed_integral_A = 0.0;
+  double force_integral_kN_s = 0.0;
+  bool releasing = true;               // force mode below release_force_kN
+};
+
+struct ControllerOutput {
+  double current_command_A = 0.0;
+  double speed_reference_rev_per_s = 0.0;
+  bool saturated = false;
+};
+
+class LocalController {
+ public:
+  explicit LocalController(const ControllerParams& params);  // throws std::invalid_argument
+
+  void reset();
+  ControllerOutput update_position(const PositionReference& ref, const ControllerInputs& in, double dt_s);
+  ControllerOutput update_force(double force_command_kN, const ControllerInputs& in, double dt_s);
+
+  const ControllerState& state() const { return s_; }
+  const ControllerParams& params() const { return p_; }
+
+ private:
+  ControllerOutput speed_loop(double v_ref, double a_ff, const ControllerInputs& in, double dt_s);
+
+  ControllerParams p_;
+  ControllerState s_;
+};
+
+}  // namespace bbw::corner_unit

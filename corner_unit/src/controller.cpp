@@ -1,0 +1,126 @@
+#include "bbw/corner_unit/controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace bbw::corner_unit {
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+
+void positive(const char* field, double v) {
+  if (!(std::isfinite(v) && v > 0.0)) {
+    std::ostringstream os;
+    os << field << " = " << v << ": must be > 0";
+    throw std::invalid_argument(os.str());
+  }
+}
+void non_negative(const char* field, double v) {
+  if (!(std::isfinite(v) && v >= 0.0)) {
+    std::ostringstream os;
+    os << field << " = " << v << ": must be >= 0";
+    throw std::invalid_argument(os.str());
+  }
+}
+
+}  // namespace
+
+void ControllerParams::validate() const {
+  positive("actuator.torque_per_A_Nm", actuator.torque_per_A_Nm);
+  positive("actuator.Nm_per_kN", actuator.Nm_per_kN);
+  non_negative("actuator.inertia_kg_m2", actuator.inertia_kg_m2);
+  positive("current_limit_A", current_limit_A);
+  positive("position_gain_per_s", position_gain_per_s);
+  positive("speed_gain_A_per_rev_per_s", speed_gain_A_per_rev_per_s);
+  non_negative("speed_integral_gain_A_per_rev", speed_integral_gain_A_per_rev);
+  positive("max_speed_rev_per_s", max_speed_rev_per_s);
+  positive("force_bandwidth_rad_per_s", force_bandwidth_rad_per_s);
+  non_negative("force_integral_rad_per_s2", force_integral_rad_per_s2);
+  positive("stiffness_at_zero_kN_per_rev", stiffness_at_zero_kN_per_rev);
+  non_negative("stiffness_per_kN_per_rev", stiffness_per_kN_per_rev);
+  non_negative("release_force_kN", release_force_kN);
+  if (!std::isfinite(release_position_rev)) throw std::invalid_argument("release_position_rev must be finite");
+}
+
+const char* to_string(ForceFeedback f) {
+  switch (f) {
+    case ForceFeedback::LoadCell: return "load_cell";
+    case ForceFeedback::Compensated: return "compensated";
+    case ForceFeedback::Curve: return "curve";
+    case ForceFeedback::True: return "true";
+  }
+  return "?";
+}
+
+double select_force(ForceFeedback f, const ForceSources& s) {
+  switch (f) {
+    case ForceFeedback::LoadCell: return s.load_cell_kN;
+    case ForceFeedback::Compensated: return s.load_cell_kN - s.friction_estimate_kN;
+    case ForceFeedback::Curve: return s.curve_estimate_kN;
+    case ForceFeedback::True: return s.true_kN;
+  }
+  return s.load_cell_kN;
+}
+
+LocalController::LocalController(const ControllerParams& params) : p_(params) {
+  p_.validate();
+}
+
+void LocalController::reset() { s_ = ControllerState{}; }
+
+ControllerOutput LocalController::speed_loop(double v_ref, double a_ff, const ControllerInputs& in,
+                                             double dt_s) {
+  const double e = v_ref - in.speed_rev_per_s;
+  double i_ff = p_.actuator.inertia_kg_m2 * kTwoPi * a_ff / p_.actuator.torque_per_A_Nm;
+  if (p_.load_feedforward) {
+    i_ff += std::max(in.load_force_kN, 0.0) * p_.actuator.Nm_per_kN / p_.actuator.torque_per_A_Nm;
+  }
+  const double unclipped = p_.speed_gain_A_per_rev_per_s * e + s_.speed_integral_A + i_ff;
+  const double lim = p_.current_limit_A;
+  const double cmd = std::clamp(unclipped, -lim, lim);
+  const bool sat = cmd != unclipped;
+  // Conditional integration: stop while clipped and the error would push further out.
+  if (!sat || (unclipped > lim && e < 0.0) || (unclipped < -lim && e > 0.0)) {
+    s_.speed_integral_A += p_.speed_integral_gain_A_per_rev * e * dt_s;
+    s_.speed_integral_A = std::clamp(s_.speed_integral_A, -lim, lim);
+  }
+  return ControllerOutput{cmd, v_ref, sat};
+}
+
+ControllerOutput LocalController::update_position(const PositionReference& ref, const ControllerInputs& in,
+                                                  double dt_s) {
+  if (!(dt_s > 0.0)) return ControllerOutput{};
+  const double unclipped = ref.speed_rev_per_s + p_.position_gain_per_s * (ref.position_rev - in.position_rev);
+  const double v_ref = std::clamp(unclipped, -p_.max_speed_rev_per_s, p_.max_speed_rev_per_s);
+  const double a_ff = v_ref == unclipped ? ref.accel_rev_per_s2 : 0.0;
+  return speed_loop(v_ref, a_ff, in, dt_s);
+}
+
+ControllerOutput LocalController::update_force(double force_command_kN, const ControllerInputs& in,
+                                               double dt_s) {
+  if (!(dt_s > 0.0)) return ControllerOutput{};
+  if (force_command_kN <= p_.release_force_kN) {
+    s_.releasing = true;
+    s_.force_integral_kN_s = 0.0;
+    return update_position(PositionReference{p_.release_position_rev, 0.0, 0.0}, in, dt_s);
+  }
+  s_.releasing = false;
+  const double e = force_command_kN - in.force_feedback_kN;
+  const double k = p_.stiffness_at_zero_kN_per_rev +
+                   p_.stiffness_per_kN_per_rev * std::max(in.force_feedback_kN, 0.0);
+  const double unclipped =
+      (p_.force_bandwidth_rad_per_s * e + p_.force_integral_rad_per_s2 * s_.force_integral_kN_s) / k;
+  const double v_ref = std::clamp(unclipped, -p_.max_speed_rev_per_s, p_.max_speed_rev_per_s);
+  ControllerOutput out = speed_loop(v_ref, 0.0, in, dt_s);
+  const bool clipped = v_ref != unclipped || out.saturated;
+  const double push = unclipped - v_ref + (out.saturated ? out.current_command_A : 0.0);
+  if (!clipped || (push > 0.0 && e < 0.0) || (push < 0.0 && e > 0.0)) {
+    s_.force_integral_kN_s += e * dt_s;
+  }
+  out.saturated = clipped;
+  return out;
+}
+
+}  // namespace bbw::corner_unit

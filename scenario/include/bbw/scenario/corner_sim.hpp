@@ -1,0 +1,88 @@
+// One corner in simulation: plant + sensors + local controller + reference profile. Both the
+// offline simulator and the DDS corner process step this same class, so they produce the same
+// numbers for the same scenario, corner and inputs. Pure: time advances only through step().
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "bbw/corner_unit/controller.hpp"
+#include "bbw/plant/plant.hpp"
+#include "bbw/scenario/profile.hpp"
+#include "bbw/scenario/scenario.hpp"
+
+namespace bbw::scenario {
+
+enum class CommandKind { Position, Force };
+
+// One measurement sample. Fields measured by sensors come first; *_true fields are the
+// simulation's ground truth (not available to a real corner).
+struct CornerSample {
+  std::uint64_t seq = 0;            // 1 for the first step
+  double time_s = 0.0;
+  double position_rev = 0.0;        // resolver
+  double speed_rev_s = 0.0;         // resolver speed
+  double force_internal_kN = 0.0;   // load cell
+  double force_external_kN = 0.0;   // external (test rig) force sensor
+  double force_true_kN = 0.0;       // truth
+  double temperature_C = 0.0;       // temperature sensor
+  double motor_current_A = 0.0;     // current sensor
+  CommandKind command_kind = CommandKind::Position;
+  double command = 0.0;             // position_rev or force_kN, per command_kind
+  double current_command_A = 0.0;
+  double force_feedback_kN = 0.0;   // what the force loop used (0 in position mode)
+  double friction_true_kN = 0.0;    // truth: all friction in the load cell (key + viscous)
+  double position_true_rev = 0.0;   // truth: spindle position
+};
+
+// A curve estimate from the calibrator: F = ((A x + B) x + C) x + D, kN with x in rev.
+struct CurveEstimate {
+  double a = 0.0, b = 0.0, c = 0.0, d = 0.0;
+  double force_kN(double x_rev) const { return ((a * x_rev + b) * x_rev + c) * x_rev + d; }
+};
+
+// What the outside (the CCU) may supply each step.
+struct ExternalInputs {
+  // A clamp-force command; when present it replaces the profile and the corner runs in force
+  // mode (whatever its drive mode), using the corner's feedback choice (load_cell for a
+  // position-driven corner).
+  std::optional<double> force_command_kN;
+  // For feedback `compensated`: the friction the load cell is believed to contain.
+  double friction_estimate_kN = 0.0;
+  // For feedback `curve`: the calibrated curve; without one the load cell is used.
+  std::optional<CurveEstimate> curve;
+};
+
+class CornerSim {
+ public:
+  // Builds corner `index` of the scenario. Throws std::invalid_argument / std::out_of_range.
+  CornerSim(const Scenario& scenario, std::size_t index);
+
+  // Advances by dt_s and returns the new sample. Allocation-free.
+  const CornerSample& step(double dt_s, const ExternalInputs& ext = {});
+
+  const CornerSample& last() const { return sample_; }
+  const std::string& name() const { return name_; }
+  const plant::Plant& plant() const { return plant_; }
+  const corner_unit::LocalController& controller() const { return controller_; }
+  double time_s() const { return time_s_; }
+  // The force-feedback choice in force mode.
+  corner_unit::ForceFeedback feedback() const { return feedback_; }
+
+ private:
+  std::string name_;
+  plant::Plant plant_;
+  corner_unit::LocalController controller_;
+  DriveMode mode_;
+  corner_unit::ForceFeedback feedback_;
+  std::optional<PositionProfile> position_profile_;
+  std::optional<BreakpointProfile> force_profile_;
+  double force_scale_ = 1.0;        // demand drive: axle factor * max clamp force
+  double time_s_ = 0.0;
+  std::uint64_t seq_ = 0;
+  CornerSample sample_;
+};
+
+}  // namespace bbw::scenario

@@ -1,0 +1,114 @@
+#include "bbw/scenario/corner_sim.hpp"
+
+#include <stdexcept>
+
+namespace bbw::scenario {
+namespace {
+
+plant::PlantParams corner_plant(const Scenario& s, std::size_t index) {
+  plant::PlantParams p = s.plant;
+  p.sensors = s.corners[index].sensors;
+  return p;
+}
+
+const CornerSpec& corner_at(const Scenario& s, std::size_t index) {
+  if (index >= s.corners.size()) {
+    throw std::out_of_range("CornerSim: scenario '" + s.name + "' has no corner " + std::to_string(index));
+  }
+  return s.corners[index];
+}
+
+corner_unit::ControllerParams corner_controller(const Scenario& s) {
+  corner_unit::ControllerParams c = s.controller;
+  c.actuator = actuator_model(s.plant);
+  c.current_limit_A = s.plant.motor.current_limit_A;
+  return c;
+}
+
+}  // namespace
+
+CornerSim::CornerSim(const Scenario& scenario, std::size_t index)
+    : name_(corner_at(scenario, index).name),
+      plant_(corner_plant(scenario, index), scenario.corners[index].effects, scenario.corners[index].conditions,
+             corner_seed(scenario.seed, index), scenario.plant_dt_s),
+      controller_(corner_controller(scenario)),
+      mode_(scenario.corners[index].drive.mode),
+      feedback_(scenario.corners[index].drive.feedback) {
+  const CornerSpec& c = scenario.corners[index];
+  switch (mode_) {
+    case DriveMode::Position:
+      position_profile_.emplace(c.drive.position);
+      plant_.reset(c.drive.position.start_rev);
+      break;
+    case DriveMode::Force:
+      force_profile_.emplace(c.drive.force_kN);
+      plant_.reset(controller_.params().release_position_rev);
+      break;
+    case DriveMode::Demand: {
+      if (!scenario.demand) throw std::invalid_argument("corner " + c.name + ": demand drive needs a scenario demand");
+      const auto axle = c.axle ? c.axle : axle_from_name(c.name);
+      if (!axle) throw std::invalid_argument("corner " + c.name + ": demand drive needs an axle");
+      force_profile_.emplace(scenario.demand->profile);
+      force_scale_ = scenario.demand->max_clamp_force_kN * scenario.demand->axle_factor(*axle);
+      plant_.reset(controller_.params().release_position_rev);
+      break;
+    }
+  }
+  const plant::Measurement& m = plant_.measurement();
+  sample_.position_rev = m.position_rev;
+  sample_.force_internal_kN = m.force_internal_kN;
+  sample_.force_external_kN = m.force_external_kN;
+  sample_.force_true_kN = plant_.state().force_true_kN;
+  sample_.temperature_C = m.temperature_C;
+  sample_.position_true_rev = plant_.state().position_rev;
+}
+
+const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
+  if (!(dt_s > 0.0)) return sample_;
+  const double t_next = time_s_ + dt_s;
+  const plant::Measurement& m = plant_.measurement();
+  corner_unit::ControllerInputs in;
+  in.position_rev = m.position_rev;
+  in.speed_rev_per_s = m.speed_rev_per_s;
+  in.load_force_kN = m.force_internal_kN;
+  corner_unit::ControllerOutput out;
+  const bool force_mode = ext.force_command_kN.has_value() || mode_ != DriveMode::Position;
+  if (force_mode) {
+    const double cmd = ext.force_command_kN ? *ext.force_command_kN : force_scale_ * force_profile_->at(t_next).value;
+    corner_unit::ForceSources src;
+    src.load_cell_kN = m.force_internal_kN;
+    src.friction_estimate_kN = ext.friction_estimate_kN;
+    src.curve_estimate_kN = ext.curve ? ext.curve->force_kN(m.position_rev) : m.force_internal_kN;
+    src.true_kN = plant_.state().force_true_kN;
+    const auto fb = mode_ == DriveMode::Position ? corner_unit::ForceFeedback::LoadCell : feedback_;
+    in.force_feedback_kN = corner_unit::select_force(fb, src);
+    out = controller_.update_force(cmd, in, dt_s);
+    sample_.command_kind = CommandKind::Force;
+    sample_.command = cmd;
+  } else {
+    const Reference r = position_profile_->at(t_next);
+    out = controller_.update_position(corner_unit::PositionReference{r.value, r.rate, r.accel}, in, dt_s);
+    sample_.command_kind = CommandKind::Position;
+    sample_.command = r.value;
+  }
+  sample_.force_feedback_kN = in.force_feedback_kN;
+  sample_.current_command_A = out.current_command_A;
+
+  const plant::Measurement& y = plant_.step(plant::PlantInputs{out.current_command_A}, dt_s);
+  const plant::PlantState& s = plant_.state();
+  time_s_ = t_next;
+  sample_.seq = ++seq_;
+  sample_.time_s = time_s_;
+  sample_.position_rev = y.position_rev;
+  sample_.speed_rev_s = y.speed_rev_per_s;
+  sample_.force_internal_kN = y.force_internal_kN;
+  sample_.force_external_kN = y.force_external_kN;
+  sample_.force_true_kN = s.force_true_kN;
+  sample_.temperature_C = y.temperature_C;
+  sample_.motor_current_A = y.motor_current_A;
+  sample_.friction_true_kN = s.friction_kN;
+  sample_.position_true_rev = s.position_rev;
+  return sample_;
+}
+
+}  // namespace bbw::scenario

@@ -1,0 +1,257 @@
+#include "bbw/scenario/load.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <set>
+#include <stdexcept>
+
+#include "bbw/plant/params_yaml.hpp"
+
+namespace bbw::scenario {
+
+using config::ConfigError;
+using config::Range;
+using config::Reader;
+
+namespace {
+
+int line_of(const YAML::Node& n) { return n.IsDefined() && n.Mark().line >= 0 ? n.Mark().line + 1 : 0; }
+
+std::string child(const Reader& r, const std::string& key) {
+  return r.path().empty() ? key : r.path() + "." + key;
+}
+
+// Reader::finish() for mappings holding a key read straight from the YAML node (a list of
+// [t, value] pairs): rejects every key not in `allowed`.
+void finish_with(const Reader& r, const std::set<std::string>& allowed) {
+  for (const auto& kv : r.node()) {
+    const std::string k = kv.first.Scalar();
+    if (allowed.count(k) == 0) throw ConfigError(r.file(), line_of(kv.first), child(r, k), "unknown key");
+  }
+}
+
+// A required list of [t_s, value] pairs with strictly increasing times and values in `range`.
+std::vector<Breakpoint> read_breakpoints(const Reader& r, const std::string& key, const Range& range) {
+  const YAML::Node n = r.node()[key];
+  if (!n.IsDefined() || n.IsNull()) r.fail(key, "required key is missing");
+  if (!n.IsSequence() || n.size() == 0) r.fail(key, "must be a non-empty list of [t_s, value] pairs");
+  std::vector<Breakpoint> out;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const YAML::Node item = n[i];
+    const std::string path = child(r, key + "[" + std::to_string(i) + "]");
+    if (!item.IsSequence() || item.size() != 2 || !item[0].IsScalar() || !item[1].IsScalar()) {
+      throw ConfigError(r.file(), line_of(item), path, "must be a pair [t_s, value]");
+    }
+    Breakpoint b;
+    try {
+      b.t_s = item[0].as<double>();
+      b.value = item[1].as<double>();
+    } catch (const YAML::Exception&) {
+      throw ConfigError(r.file(), line_of(item), path, "must be a pair of numbers [t_s, value]");
+    }
+    if (!Range::non_negative().contains(b.t_s)) {
+      throw ConfigError(r.file(), line_of(item), path, "time must be a finite number >= 0");
+    }
+    if (!range.contains(b.value)) throw ConfigError(r.file(), line_of(item), path, "value " + range.describe());
+    if (!out.empty() && !(b.t_s > out.back().t_s)) {
+      throw ConfigError(r.file(), line_of(item), path, "times must increase strictly");
+    }
+    out.push_back(b);
+  }
+  return out;
+}
+
+int count(Reader& r, const std::string& key, int fallback) {
+  return static_cast<int>(r.integer_or(key, fallback, 1, 100000));
+}
+
+PositionSegment read_segment(Reader& s) {
+  const std::string type = s.choice("type", {"paper_sweep", "local_loops", "sine", "steps", "hold"});
+  const Range pos = Range::closed(-2.0, 12.0);
+  PositionSegment out;
+  if (type == "paper_sweep") {
+    PaperSweep p;
+    p.x_low_rev = s.number("x_low_rev", pos);
+    p.amplitudes_rev = s.numbers("amplitudes_rev", Range{0.0, 12.0, true, false});
+    if (p.amplitudes_rev.empty()) s.fail("amplitudes_rev", "must not be empty");
+    p.period_s = s.number("period_s", Range::closed(0.01, 1000.0));
+    p.cycles_per_amplitude = count(s, "cycles_per_amplitude", 1);
+    out = p;
+  } else if (type == "local_loops") {
+    LocalLoops l;
+    l.levels_rev = s.numbers("levels_rev", pos);
+    if (l.levels_rev.empty()) s.fail("levels_rev", "must not be empty");
+    l.amplitude_rev = s.number("amplitude_rev", Range{0.0, 5.0, true, false});
+    l.period_s = s.number("period_s", Range::closed(0.01, 1000.0));
+    l.cycles_per_level = count(s, "cycles_per_level", 2);
+    l.ramp_s = s.number_or("ramp_s", 1.0, Range::closed(0.01, 1000.0));
+    out = l;
+  } else if (type == "sine") {
+    Sine w;
+    w.offset_rev = s.number("offset_rev", pos);
+    w.amplitude_rev = s.number("amplitude_rev", Range{0.0, 10.0, true, false});
+    w.period_s = s.number("period_s", Range::closed(0.01, 1000.0));
+    w.cycles = count(s, "cycles", 1);
+    out = w;
+  } else if (type == "steps") {
+    Steps st;
+    st.levels_rev = s.numbers("levels_rev", pos);
+    if (st.levels_rev.empty()) s.fail("levels_rev", "must not be empty");
+    st.hold_s = s.number("hold_s", Range::closed(0.001, 1000.0));
+    out = st;
+  } else {
+    Hold h;
+    h.position_rev = s.number("position_rev", pos);
+    h.duration_s = s.number("duration_s", Range::closed(0.001, 100000.0));
+    out = h;
+  }
+  s.finish();
+  return out;
+}
+
+corner_unit::ForceFeedback read_feedback(Reader& d) {
+  const std::string f = d.choice_or("feedback", "load_cell", {"load_cell", "compensated", "curve", "true"});
+  if (f == "compensated") return corner_unit::ForceFeedback::Compensated;
+  if (f == "curve") return corner_unit::ForceFeedback::Curve;
+  if (f == "true") return corner_unit::ForceFeedback::True;
+  return corner_unit::ForceFeedback::LoadCell;
+}
+
+DriveSpec read_drive(Reader& d) {
+  DriveSpec drive;
+  const std::string mode = d.choice("mode", {"position", "force", "demand"});
+  if (mode == "position") {
+    drive.mode = DriveMode::Position;
+    drive.position.start_rev = d.number_or("start_rev", 0.0, Range::closed(-2.0, 12.0));
+    drive.position.ramp_s = d.number_or("ramp_s", 1.0, Range::closed(0.01, 1000.0));
+    for (Reader& s : d.maps("segments")) drive.position.segments.push_back(read_segment(s));
+    if (drive.position.segments.empty()) d.fail("segments", "must list at least one segment");
+    d.finish();
+    try {
+      PositionProfile check(drive.position);
+    } catch (const std::invalid_argument& e) {
+      d.fail("segments", e.what());
+    }
+  } else if (mode == "force") {
+    drive.mode = DriveMode::Force;
+    drive.feedback = read_feedback(d);
+    drive.force_kN = read_breakpoints(d, "breakpoints", Range::closed(0.0, 100.0));
+    finish_with(d, {"mode", "feedback", "breakpoints"});
+  } else {
+    drive.mode = DriveMode::Demand;
+    drive.feedback = read_feedback(d);
+    d.finish();
+  }
+  return drive;
+}
+
+corner_unit::ControllerParams read_controller(Reader& c) {
+  corner_unit::ControllerParams p;
+  p.position_gain_per_s = c.number_or("position_gain_per_s", p.position_gain_per_s, Range::positive());
+  p.speed_gain_A_per_rev_per_s =
+      c.number_or("speed_gain_A_per_rev_per_s", p.speed_gain_A_per_rev_per_s, Range::positive());
+  p.speed_integral_gain_A_per_rev =
+      c.number_or("speed_integral_gain_A_per_rev", p.speed_integral_gain_A_per_rev, Range::non_negative());
+  p.max_speed_rev_per_s = c.number_or("max_speed_rev_per_s", p.max_speed_rev_per_s, Range::positive());
+  p.force_bandwidth_rad_per_s =
+      c.number_or("force_bandwidth_rad_per_s", p.force_bandwidth_rad_per_s, Range::positive());
+  p.force_integral_rad_per_s2 =
+      c.number_or("force_integral_rad_per_s2", p.force_integral_rad_per_s2, Range::non_negative());
+  p.stiffness_at_zero_kN_per_rev =
+      c.number_or("stiffness_at_zero_kN_per_rev", p.stiffness_at_zero_kN_per_rev, Range::positive());
+  p.stiffness_per_kN_per_rev =
+      c.number_or("stiffness_per_kN_per_rev", p.stiffness_per_kN_per_rev, Range::non_negative());
+  p.release_force_kN = c.number_or("release_force_kN", p.release_force_kN, Range::closed(0.0, 10.0));
+  p.release_position_rev = c.number_or("release_position_rev", p.release_position_rev, Range::closed(-2.0, 12.0));
+  p.load_feedforward = c.boolean_or("load_feedforward", p.load_feedforward);
+  c.finish();
+  return p;
+}
+
+CornerSpec read_corner(Reader& c, const Scenario& sc) {
+  CornerSpec k;
+  k.name = c.string("name");
+  if (k.name.empty()) c.fail("name", "must not be empty");
+  if (c.has("axle")) {
+    k.axle = c.choice("axle", {"front", "rear"}) == "front" ? Axle::Front : Axle::Rear;
+  } else {
+    c.string_or("axle", "");
+    k.axle = axle_from_name(k.name);
+  }
+  k.conditions.temperature_C = c.number("temperature_C", Range::closed(-40.0, 140.0));
+  k.conditions.temperature_rate_C_per_s = c.number_or("temperature_rate_C_per_s", 0.0, Range::closed(-10.0, 10.0));
+  if (auto w = c.optional_map("wear")) {
+    k.conditions.wear_initial_rev = w->number_or("initial_rev", 0.0, Range::closed(-1.0, 5.0));
+    k.conditions.wear_rate_rev_per_kN_s = w->number_or("rate_rev_per_kN_s", 0.0, Range::closed(0.0, 1.0));
+    w->finish();
+  }
+  if (auto e = c.optional_map("effects")) {
+    k.effects = plant::read_effects(*e);
+  } else {
+    k.effects = plant::EffectsParams{};
+  }
+  if (auto s = c.optional_map("sensor")) {
+    k.sensors = plant::read_sensor_overrides(*s, sc.plant.sensors);
+  } else {
+    k.sensors = sc.plant.sensors;
+  }
+  Reader d = c.map("drive");
+  k.drive = read_drive(d);
+  if (k.drive.mode == DriveMode::Demand) {
+    if (!sc.demand) c.fail("drive", "mode 'demand' needs a top-level 'demand:' section");
+    if (!k.axle) c.fail("axle", "mode 'demand' needs 'axle: front|rear' when the name is not FL/FR/RL/RR");
+  }
+  c.finish();
+  return k;
+}
+
+Scenario read_scenario(Reader& r, const ExtraKeys& extra) {
+  Scenario s;
+  s.file = r.file();
+  s.name = r.string("name");
+  if (s.name.empty()) r.fail("name", "must not be empty");
+  s.seed = static_cast<std::uint64_t>(r.integer("seed", 0, std::numeric_limits<std::int64_t>::max()));
+  s.duration_s = r.number("duration_s", Range{0.0, 1.0e5, true, false});
+  s.plant_dt_s = r.number_or("plant_dt_s", 0.001, Range::closed(1.0e-5, 0.01));
+  s.ccu_period_s = r.number_or("ccu_period_s", 0.005, Range::closed(1.0e-4, 1.0));
+  if (s.ccu_period_s < s.plant_dt_s) r.fail("ccu_period_s", "must be >= plant_dt_s");
+  s.plant_file = config::resolve_relative(r.file(), r.string("plant"));
+  s.plant = plant::load_plant_params(s.plant_file);
+  if (auto c = r.optional_map("controller")) {
+    s.controller = read_controller(*c);
+  }
+  if (auto d = r.optional_map("demand")) {
+    DemandSpec dm;
+    dm.max_clamp_force_kN = d->number("max_clamp_force_kN", Range{0.0, 100.0, true, false});
+    dm.front_share = d->number("front_share", Range::closed(0.5, 0.9));
+    dm.profile = read_breakpoints(*d, "profile", Range::closed(0.0, 1.0));
+    finish_with(*d, {"max_clamp_force_kN", "front_share", "profile"});
+    s.demand = dm;
+  }
+  std::vector<Reader> corners = r.maps("corners");
+  if (corners.empty()) r.fail("corners", "must list at least one corner");
+  std::set<std::string> names;
+  for (Reader& c : corners) {
+    s.corners.push_back(read_corner(c, s));
+    if (!names.insert(s.corners.back().name).second) {
+      c.fail("name", "duplicate corner name '" + s.corners.back().name + "'");
+    }
+  }
+  if (extra) extra(r);
+  r.finish();
+  return s;
+}
+
+}  // namespace
+
+Scenario load_scenario(const std::string& file, const ExtraKeys& extra) {
+  Reader r = Reader::from_file(file);
+  return read_scenario(r, extra);
+}
+
+Scenario load_scenario_string(const std::string& text, const std::string& name, const ExtraKeys& extra) {
+  Reader r = Reader::from_string(text, name);
+  return read_scenario(r, extra);
+}
+
+}  // namespace bbw::scenario
