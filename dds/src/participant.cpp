@@ -1,5 +1,7 @@
 #include "bbw/dds/participant.hpp"
 
+#include <bbw/idl/bbw_msgsTypeObject.h>
+
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 
@@ -40,6 +42,9 @@ void load_profiles(const std::string& file) {
 
 Participant::Participant(const ParticipantOptions& options) : domain_id_(options.domain_id) {
   auto* factory = fdds::DomainParticipantFactory::get_instance();
+  // Content filters need the TypeObjects, which are otherwise registered only when a message
+  // object is first constructed.
+  registerbbw_msgsTypes();
   const std::string file = options.profiles_file.empty() ? default_profiles_file() : options.profiles_file;
   load_profiles(file);
 

@@ -1,0 +1,83 @@
+// bbw_dds_echo: answers every MeasurementBlock with a ClampCommand for the same corner and
+// step, over the same topics and QoS profiles as bbw_ccu. The peer of the round-trip latency
+// benchmark and of the two-process DDS system test.
+//
+//   bbw_dds_echo [--domain N] [--mode lockstep|realtime] [--max-blocks K]
+// Exits 0 after K blocks (if given) or on SIGINT/SIGTERM; 2 on bad arguments; 1 on DDS errors.
+#include <bbw/idl/bbw_msgsPubSubTypes.h>
+
+#include <cstdlib>
+#include <iostream>
+#include <optional>
+#include <string>
+
+#include "bbw/dds/domain.hpp"
+#include "bbw/dds/events.hpp"
+#include "bbw/dds/participant.hpp"
+#include "bbw/dds/reader.hpp"
+#include "bbw/dds/topics.hpp"
+#include "bbw/dds/writer.hpp"
+#include "bbw/launch/signals.hpp"
+
+int main(int argc, char** argv) {
+  bbw::dds::Events events;
+  bbw::launch::SignalWatcher signals([&](int) { events.interrupt(); });
+  std::optional<std::string> domain_arg;
+  std::string mode = "realtime";
+  long long max_blocks = -1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--domain" && i + 1 < argc) {
+      domain_arg = argv[++i];
+    } else if (a == "--mode" && i + 1 < argc) {
+      mode = argv[++i];
+    } else if (a == "--max-blocks" && i + 1 < argc) {
+      max_blocks = std::atoll(argv[++i]);
+    } else {
+      std::cerr << "bbw_dds_echo: unknown argument '" << a << "'\n"
+                << "usage: bbw_dds_echo [--domain N] [--mode lockstep|realtime] [--max-blocks K]\n";
+      return 2;
+    }
+  }
+  if (mode != "lockstep" && mode != "realtime") {
+    std::cerr << "bbw_dds_echo: --mode must be lockstep or realtime, got '" << mode << "'\n";
+    return 2;
+  }
+  try {
+    const int domain = bbw::dds::resolve_domain_id(domain_arg, std::getenv("BBW_DOMAIN"));
+    const auto profiles = bbw::dds::profiles_for(mode == "lockstep");
+    bbw::dds::ParticipantOptions opt;
+    opt.domain_id = domain;
+    opt.name = "bbw_dds_echo";
+    bbw::dds::Participant participant(opt);
+    bbw::dds::Reader<bbw::msg::MeasurementBlockPubSubType> blocks(
+        participant, bbw::dds::kMeasurementTopic, profiles.measurement_reader, events);
+    bbw::dds::Writer<bbw::msg::ClampCommandPubSubType> commands(
+        participant, bbw::dds::kCommandTopic, profiles.command_writer, events);
+    std::cout << "bbw_dds_echo: domain " << domain << ", mode " << mode << ", waiting" << std::endl;
+    long long echoed = 0;
+    bbw::msg::MeasurementBlock in;
+    bbw::msg::ClampCommand out;
+    while (!events.interrupted() && (max_blocks < 0 || echoed < max_blocks)) {
+      events.wait_until(bbw::dds::Events::Clock::time_point::max(), [&] {
+        while (blocks.take(in)) {
+          out.corner_id(in.corner_id());
+          out.seq(in.block_seq());
+          out.step(in.block_seq());
+          out.time_s(in.period_start_s());
+          out.clamp_force_kN(in.samples().empty() ? 0.0 : in.samples().back().force_internal_kN());
+          out.mode(bbw::msg::MODE_FORCE);
+          out.valid(true);
+          commands.write(out);
+          ++echoed;
+        }
+        return max_blocks >= 0 && echoed >= max_blocks;
+      });
+    }
+    std::cout << "bbw_dds_echo: echoed " << echoed << " blocks" << std::endl;
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "bbw_dds_echo: " << e.what() << "\n";
+    return 1;
+  }
+}
