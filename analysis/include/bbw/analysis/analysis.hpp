@@ -1,0 +1,107 @@
+// Residual analysis (issue 6): fit the calibrator's eq. 5 model to a whole recording, then find,
+// by held-out error, which candidate effect the model lacks; add it, refit, repeat; finally test
+// the residual for structure that no candidate explains. Pure: no files, no clock.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bbw/analysis/options.hpp"
+
+namespace bbw::analysis {
+
+struct Channel {
+  std::string name;
+  std::vector<double> values;
+};
+
+// A uniformly sampled recording. Optional vectors are empty when absent.
+struct Recording {
+  std::vector<double> time_s;
+  std::vector<double> position;
+  std::vector<double> force;
+  std::vector<double> truth;         // true force (same unit as force), optional
+  std::vector<double> temperature;   // optional
+  std::vector<double> velocity;      // optional; derived from position when empty
+  std::vector<double> acceleration;  // optional; derived from position when empty
+  std::vector<Channel> channels;     // other recorded channels, tried as candidates
+};
+
+struct ErrorFigures {
+  double rms_residual = 0.0;
+  double max_residual = 0.0;
+  double holdout_rms_residual = 0.0;
+  bool has_truth = false;
+  double rms_truth_error = 0.0;  // clamp-force estimate minus truth
+  double max_truth_error = 0.0;
+};
+
+struct Parameter {
+  std::string name;
+  double value = 0.0;
+  std::string unit;  // in terms of the recording's units: "force", "force/position", "s", ...
+};
+
+// One scored candidate in one round.
+struct CandidateScore {
+  std::string name;             // effect name; channels as "channel:NAME" / "channel:NAME*velocity"
+  std::string hyper_name;       // "tau_s", "width", "delay_s" or empty
+  double hyper_value = 0.0;
+  double holdout_rms = 0.0;
+  double relative_drop = 0.0;   // 1 - holdout_rms / current holdout rms
+  double t_statistic = 0.0;     // paired held-out improvement, block means
+  bool significant = false;
+};
+
+struct Step {
+  CandidateScore evidence;
+  std::string runner_up;        // the second-best candidate of that round
+  double runner_up_relative_drop = 0.0;
+  std::vector<Parameter> parameters;  // the effect's own fitted parameters
+  double delta_max = 0.0;             // re-chosen after the step
+  ErrorFigures errors;
+};
+
+struct StructureFinding {
+  std::string test;       // "whiteness", "position", "time", "velocity", "channel:NAME", ...
+  double statistic = 0.0; // Ljung-Box Q or F
+  double critical = 0.0;
+  double effect = 0.0;    // structured RMS / noise RMS (whiteness) or eta^2 (dependence)
+  double effect_threshold = 0.0;
+  bool significant = false;
+  bool flagged = false;   // significant and effect above threshold
+};
+
+struct AnalysisResult {
+  std::size_t samples = 0;
+  double dt_s = 0.0;
+  std::size_t holdout_samples = 0;
+  std::string differentiator;  // how velocity and acceleration were obtained
+
+  double baseline_delta_max = 0.0;
+  std::vector<Parameter> baseline_parameters;  // A..D (position units), K_i, Delta_i
+  ErrorFigures baseline;
+  std::vector<Step> steps;
+  std::vector<Parameter> final_parameters;  // every term of the final model
+  ErrorFigures final_errors;
+  std::vector<std::vector<CandidateScore>> rounds;  // every round's scores, best first
+  std::vector<CandidateScore> rejected;             // the last round (none was accepted)
+
+  std::vector<StructureFinding> structure;
+  bool unexplained_structure = false;
+  std::vector<std::string> structure_notes;
+
+  // Signals for plots (full length).
+  std::vector<double> residual_before, residual_after;
+  std::vector<double> truth_error_before, truth_error_after;  // empty without truth
+  std::string display_regressor_name;  // the first step's regressor (or position)
+  std::vector<double> display_regressor;
+  std::vector<double> velocity;
+};
+
+// Runs the whole analysis. Throws std::invalid_argument for an unusable recording (too short,
+// mismatched lengths, non-uniform or non-increasing time, constant position).
+AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options);
+
+}  // namespace bbw::analysis

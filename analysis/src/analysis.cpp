@@ -1,0 +1,632 @@
+#include "bbw/analysis/analysis.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+#include "bbw/analysis/bounded_lsq.hpp"
+#include "bbw/analysis/differentiate.hpp"
+#include "bbw/analysis/effects.hpp"
+#include "bbw/analysis/residual_tests.hpp"
+#include "bbw/calibration/maxwell_slip.hpp"
+
+namespace bbw::analysis {
+
+namespace {
+
+using Index = Eigen::Index;
+using Vec = std::vector<double>;
+
+struct ColumnEffect {
+  EffectKind kind;
+  std::string name;   // report name
+  double hyper = 0.0; // tau_s for creep
+  int channel = -1;
+};
+
+// The model: eq. 5 on an effective position (delayed and/or through a play operator) plus
+// extra columns.
+struct Spec {
+  double delta_max = 0.0;
+  bool has_delay = false;
+  double delay_s = 0.0;
+  bool has_backlash = false;
+  double backlash_width = 0.0;
+  std::vector<ColumnEffect> columns;
+};
+
+struct Design {
+  Eigen::MatrixXd x;
+  std::vector<bool> nonneg;
+  std::vector<int> owner;  // -2 curve, -1 friction, >= 0 index into Spec::columns
+  Vec deltas;
+  Vec x_eff;
+};
+
+struct Context {
+  Context(const Recording& r, const AnalysisOptions& o) : rec(r), opt(o) {}
+  const Recording& rec;
+  const AnalysisOptions& opt;
+  std::size_t n = 0;
+  double dt = 0.0;
+  double xmin = 0.0, xmax = 0.0, xrange = 0.0;
+  Vec v, a;
+  double temp_mean = 0.0;
+  Eigen::VectorXd y;
+  std::vector<Index> train, train_search, holdout;
+  // From the last accepted fit: the curve and the friction, for columns built on them.
+  Vec ref_curve, ref_friction;
+  double ref_curve_scale = 1.0;
+};
+
+double rms_of(const Eigen::VectorXd& r, const std::vector<Index>& rows) {
+  double s = 0.0;
+  for (Index k : rows) s += r(k) * r(k);
+  return rows.empty() ? 0.0 : std::sqrt(s / static_cast<double>(rows.size()));
+}
+
+std::vector<Vec> column_values(const Context& c, const ColumnEffect& e) {
+  const std::size_t n = c.n;
+  switch (e.kind) {
+    case EffectKind::ViscousFriction: return {c.v};
+    case EffectKind::Inertia: return {c.a};
+    case EffectKind::LoadDependentFriction: {
+      Vec col(n);
+      for (std::size_t k = 0; k < n; ++k) col[k] = c.ref_friction[k] * c.ref_curve[k] / c.ref_curve_scale;
+      return {col};
+    }
+    case EffectKind::TemperatureDrift: {
+      Vec off(n), gain(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        off[k] = c.rec.temperature[k] - c.temp_mean;
+        gain[k] = off[k] * c.ref_curve[k] / c.ref_curve_scale;
+      }
+      return {off, gain};
+    }
+    case EffectKind::Creep: return {creep_regressor(c.ref_curve, c.dt, e.hyper)};
+    case EffectKind::Channel: return {c.rec.channels[static_cast<std::size_t>(e.channel)].values};
+    case EffectKind::ChannelTimesVelocity: {
+      const Vec& ch = c.rec.channels[static_cast<std::size_t>(e.channel)].values;
+      Vec col(n);
+      for (std::size_t k = 0; k < n; ++k) col[k] = ch[k] * c.v[k];
+      return {col};
+    }
+    case EffectKind::SensorDelay:
+    case EffectKind::Backlash: break;
+  }
+  return {};
+}
+
+Vec effective_position(const Context& c, const Spec& s) {
+  Vec x = c.rec.position;
+  if (s.has_delay) x = delayed(x, c.dt, s.delay_s);
+  if (s.has_backlash) x = play(x, s.backlash_width);
+  return x;
+}
+
+Design build(const Context& c, const Spec& s) {
+  Design d;
+  d.x_eff = effective_position(c, s);
+  const auto m = static_cast<std::size_t>(c.opt.elements_M);
+  d.deltas.resize(m);
+  calibration::thresholds(m, s.delta_max, true, c.opt.geometric_ratio, d.deltas.data());
+  std::vector<Vec> nreg;
+  maxwell_slip_regressors(d.x_eff, d.deltas, nreg);
+  std::vector<std::vector<Vec>> extra;
+  std::size_t p = 4 + m;
+  for (const auto& e : s.columns) {
+    extra.push_back(column_values(c, e));
+    p += extra.back().size();
+  }
+  d.x.resize(static_cast<Index>(c.n), static_cast<Index>(p));
+  const double mid = 0.5 * (c.xmax + c.xmin);
+  const double half = 0.5 * c.xrange;
+  for (std::size_t k = 0; k < c.n; ++k) {
+    const double sx = (d.x_eff[k] - mid) / half;
+    const auto r = static_cast<Index>(k);
+    d.x(r, 0) = 1.0;
+    d.x(r, 1) = sx;
+    d.x(r, 2) = sx * sx;
+    d.x(r, 3) = sx * sx * sx;
+  }
+  for (int j = 0; j < 4; ++j) {
+    d.nonneg.push_back(false);
+    d.owner.push_back(-2);
+  }
+  Index col = 4;
+  for (std::size_t i = 0; i < m; ++i, ++col) {
+    for (std::size_t k = 0; k < c.n; ++k) d.x(static_cast<Index>(k), col) = nreg[i][k];
+    d.nonneg.push_back(true);
+    d.owner.push_back(-1);
+  }
+  for (std::size_t e = 0; e < extra.size(); ++e) {
+    for (const Vec& v : extra[e]) {
+      for (std::size_t k = 0; k < c.n; ++k) d.x(static_cast<Index>(k), col) = v[k];
+      d.nonneg.push_back(false);
+      d.owner.push_back(static_cast<int>(e));
+      ++col;
+    }
+  }
+  return d;
+}
+
+Eigen::VectorXd fit(const Context& c, const Design& d, const std::vector<Index>& rows) {
+  return solve_bounded(normal_equations(d.x, c.y, rows), d.nonneg);
+}
+
+struct Evaluated {
+  Design design;
+  Eigen::VectorXd coef;
+  Eigen::VectorXd residual;
+  ErrorFigures errors;
+  Vec truth_error;
+};
+
+Evaluated evaluate(const Context& c, const Spec& s, Design d, const Eigen::VectorXd& coef) {
+  Evaluated ev;
+  ev.coef = coef;
+  ev.residual = c.y - d.x * coef;
+  ErrorFigures& e = ev.errors;
+  std::vector<Index> all(c.n);
+  std::iota(all.begin(), all.end(), Index{0});
+  e.rms_residual = rms_of(ev.residual, all);
+  e.max_residual = ev.residual.cwiseAbs().maxCoeff();
+  e.holdout_rms_residual = rms_of(ev.residual, c.holdout);
+  if (!c.rec.truth.empty()) {
+    e.has_truth = true;
+    // Estimate: the reading minus the terms attributed to the sensor.
+    Eigen::VectorXd sensor = Eigen::VectorXd::Zero(static_cast<Index>(c.n));
+    for (Index j = 0; j < d.x.cols(); ++j) {
+      const int o = d.owner[static_cast<std::size_t>(j)];
+      const bool is_sensor = o == -1 || (o >= 0 && c.opt.is_sensor_effect(to_string(s.columns[static_cast<std::size_t>(o)].kind)));
+      if (is_sensor) sensor += d.x.col(j) * coef(j);
+    }
+    // A sensor delay means the reading at t belongs to the true force at t - delay.
+    const Vec truth = (s.has_delay && c.opt.is_sensor_effect("sensor_delay")) ? delayed(c.rec.truth, c.dt, s.delay_s)
+                                                                                : c.rec.truth;
+    ev.truth_error.resize(c.n);
+    double ss = 0.0, mx = 0.0;
+    for (std::size_t k = 0; k < c.n; ++k) {
+      const double err = c.rec.force[k] - sensor(static_cast<Index>(k)) - truth[k];
+      ev.truth_error[k] = err;
+      ss += err * err;
+      mx = std::max(mx, std::abs(err));
+    }
+    e.rms_truth_error = std::sqrt(ss / static_cast<double>(c.n));
+    e.max_truth_error = mx;
+  }
+  ev.design = std::move(d);
+  return ev;
+}
+
+double search_rms(const Context& c, const Spec& s) {
+  const Design d = build(c, s);
+  const Eigen::VectorXd b = fit(c, d, c.train_search);
+  return rms_of(c.y - d.x * b, c.train_search);
+}
+
+double choose_delta_max(const Context& c, Spec s) {
+  double best = std::numeric_limits<double>::infinity();
+  double best_dm = c.opt.delta_max_fractions.front() * c.xrange;
+  for (double f : c.opt.delta_max_fractions) {
+    s.delta_max = f * c.xrange;
+    const double r = search_rms(c, s);
+    if (r < best) {
+      best = r;
+      best_dm = s.delta_max;
+    }
+  }
+  return best_dm;
+}
+
+void update_refs(Context& c, const Evaluated& ev) {
+  const Design& d = ev.design;
+  c.ref_curve.assign(c.n, 0.0);
+  c.ref_friction.assign(c.n, 0.0);
+  for (Index j = 0; j < d.x.cols(); ++j) {
+    const int o = d.owner[static_cast<std::size_t>(j)];
+    if (o != -2 && o != -1) continue;
+    Vec& target = o == -2 ? c.ref_curve : c.ref_friction;
+    for (std::size_t k = 0; k < c.n; ++k) target[k] += d.x(static_cast<Index>(k), j) * ev.coef(j);
+  }
+  double mx = 0.0;
+  for (double v : c.ref_curve) mx = std::max(mx, std::abs(v));
+  c.ref_curve_scale = mx > 0.0 ? mx : 1.0;
+}
+
+double paired_t(const Eigen::VectorXd& r_old, const Eigen::VectorXd& r_new, const std::vector<Index>& rows, int blocks) {
+  const std::size_t nb = static_cast<std::size_t>(blocks);
+  if (rows.size() < nb * 2) return 0.0;
+  Vec means(nb, 0.0);
+  for (std::size_t b = 0; b < nb; ++b) {
+    const std::size_t lo = rows.size() * b / nb, hi = rows.size() * (b + 1) / nb;
+    double s = 0.0;
+    for (std::size_t k = lo; k < hi; ++k) {
+      const Index i = rows[k];
+      s += r_old(i) * r_old(i) - r_new(i) * r_new(i);
+    }
+    means[b] = s / static_cast<double>(hi - lo);
+  }
+  const double m = std::accumulate(means.begin(), means.end(), 0.0) / static_cast<double>(nb);
+  double var = 0.0;
+  for (double x : means) var += (x - m) * (x - m);
+  var /= static_cast<double>(nb - 1);
+  if (var <= 0.0) return m > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
+  return m / std::sqrt(var / static_cast<double>(nb));
+}
+
+struct Candidate {
+  EffectKind kind;
+  std::string name;
+  int channel = -1;
+};
+
+std::vector<Candidate> candidates_for(const Context& c, const Spec& s) {
+  std::vector<Candidate> out;
+  auto has_column = [&](EffectKind k, int ch) {
+    for (const auto& e : s.columns)
+      if (e.kind == k && e.channel == ch) return true;
+    return false;
+  };
+  const auto& o = c.opt;
+  if (o.is_candidate("viscous_friction") && !has_column(EffectKind::ViscousFriction, -1))
+    out.push_back({EffectKind::ViscousFriction, "viscous_friction"});
+  if (o.is_candidate("load_dependent_friction") && !has_column(EffectKind::LoadDependentFriction, -1))
+    out.push_back({EffectKind::LoadDependentFriction, "load_dependent_friction"});
+  if (o.is_candidate("sensor_delay") && !s.has_delay) out.push_back({EffectKind::SensorDelay, "sensor_delay"});
+  if (o.is_candidate("temperature_drift") && !c.rec.temperature.empty() && !has_column(EffectKind::TemperatureDrift, -1))
+    out.push_back({EffectKind::TemperatureDrift, "temperature_drift"});
+  if (o.is_candidate("backlash") && !s.has_backlash) out.push_back({EffectKind::Backlash, "backlash"});
+  if (o.is_candidate("creep") && !has_column(EffectKind::Creep, -1)) out.push_back({EffectKind::Creep, "creep"});
+  if (o.is_candidate("inertia") && !has_column(EffectKind::Inertia, -1)) out.push_back({EffectKind::Inertia, "inertia"});
+  for (std::size_t i = 0; i < c.rec.channels.size(); ++i) {
+    const int ch = static_cast<int>(i);
+    const std::string& nm = c.rec.channels[i].name;
+    if (!has_column(EffectKind::Channel, ch)) out.push_back({EffectKind::Channel, "channel:" + nm, ch});
+    if (!has_column(EffectKind::ChannelTimesVelocity, ch))
+      out.push_back({EffectKind::ChannelTimesVelocity, "channel:" + nm + "*velocity", ch});
+  }
+  return out;
+}
+
+Spec with(const Spec& s, const Candidate& cand, double hyper) {
+  Spec t = s;
+  switch (cand.kind) {
+    case EffectKind::SensorDelay:
+      t.has_delay = true;
+      t.delay_s = hyper;
+      break;
+    case EffectKind::Backlash:
+      t.has_backlash = true;
+      t.backlash_width = hyper;
+      break;
+    default:
+      t.columns.push_back({cand.kind, cand.name, hyper, cand.channel});
+  }
+  return t;
+}
+
+struct Scored {
+  CandidateScore score;
+  Spec spec;
+};
+
+Scored score_candidate(const Context& c, const Spec& s, const Candidate& cand, const Eigen::VectorXd& current_residual,
+                       double current_holdout_rms) {
+  Scored out;
+  out.score.name = cand.name;
+  Vec grid;
+  if (cand.kind == EffectKind::SensorDelay) {
+    out.score.hyper_name = "delay_s";
+    for (double d : c.opt.delay_grid_s)
+      if (std::abs(d) >= 0.5 * c.dt) grid.push_back(d);
+  } else if (cand.kind == EffectKind::Backlash) {
+    out.score.hyper_name = "width";
+    for (double f : c.opt.backlash_width_fractions) grid.push_back(f * c.xrange);
+  } else if (cand.kind == EffectKind::Creep) {
+    out.score.hyper_name = "tau_s";
+    grid = c.opt.creep_tau_s;
+  }
+  double hyper = 0.0;
+  if (!grid.empty()) {
+    double best = std::numeric_limits<double>::infinity();
+    for (double h : grid) {
+      const double r = search_rms(c, with(s, cand, h));
+      if (r < best) {
+        best = r;
+        hyper = h;
+      }
+    }
+  }
+  out.score.hyper_value = hyper;
+  out.spec = with(s, cand, hyper);
+  const Design d = build(c, out.spec);
+  const Eigen::VectorXd b = fit(c, d, c.train);
+  const Eigen::VectorXd r = c.y - d.x * b;
+  out.score.holdout_rms = rms_of(r, c.holdout);
+  out.score.relative_drop = 1.0 - out.score.holdout_rms / current_holdout_rms;
+  out.score.t_statistic = paired_t(current_residual, r, c.holdout, c.opt.significance_blocks);
+  out.score.significant =
+      out.score.relative_drop >= c.opt.min_relative_drop && out.score.t_statistic >= c.opt.min_t_statistic;
+  return out;
+}
+
+// Curve coefficients back in position units: p(s) with s = alpha x + beta.
+std::vector<Parameter> model_parameters(const Context& c, const Spec& s, const Evaluated& ev) {
+  std::vector<Parameter> out;
+  const Eigen::VectorXd& b = ev.coef;
+  const double al = 2.0 / c.xrange;
+  const double be = -(c.xmax + c.xmin) / c.xrange;
+  out.push_back({"A", b(3) * al * al * al, "force/position^3"});
+  out.push_back({"B", (b(2) + 3.0 * b(3) * be) * al * al, "force/position^2"});
+  out.push_back({"C", (b(1) + 2.0 * b(2) * be + 3.0 * b(3) * be * be) * al, "force/position"});
+  out.push_back({"D", b(0) + b(1) * be + b(2) * be * be + b(3) * be * be * be, "force"});
+  out.push_back({"Delta_max", s.delta_max, "position"});
+  double bound = 0.0;
+  for (std::size_t i = 0; i < ev.design.deltas.size(); ++i) bound += b(static_cast<Index>(4 + i));
+  out.push_back({"friction_bound", bound, "force"});  // sum K_i Delta_i: the Coulomb-like level
+  for (std::size_t i = 0; i < ev.design.deltas.size(); ++i) {
+    const double delta = ev.design.deltas[i];
+    out.push_back({"K_" + std::to_string(i + 1), b(static_cast<Index>(4 + i)) / delta, "force/position"});
+  }
+  if (s.has_delay) out.push_back({"sensor_delay.delay_s", s.delay_s, "s"});
+  if (s.has_backlash) out.push_back({"backlash.width", s.backlash_width, "position"});
+  Index j = 4 + static_cast<Index>(ev.design.deltas.size());
+  for (const auto& e : s.columns) {
+    const std::string p = e.name + ".";
+    switch (e.kind) {
+      case EffectKind::ViscousFriction: out.push_back({p + "coefficient", b(j++), "force/(position/s)"}); break;
+      case EffectKind::Inertia: out.push_back({p + "mass", b(j++), "force/(position/s^2)"}); break;
+      case EffectKind::LoadDependentFriction:
+        out.push_back({p + "friction_gain_at_full_curve", b(j++), "1"});
+        break;
+      case EffectKind::TemperatureDrift:
+        out.push_back({p + "offset_per_degC", b(j++), "force/degC"});
+        out.push_back({p + "gain_at_full_curve_per_degC", b(j++) / c.ref_curve_scale, "force/degC per force"});
+        out.push_back({p + "reference_temperature", c.temp_mean, "degC"});
+        break;
+      case EffectKind::Creep:
+        out.push_back({p + "tau_s", e.hyper, "s"});
+        out.push_back({p + "unrelaxed_fraction", b(j++), "1"});
+        break;
+      case EffectKind::Channel: out.push_back({p + "coefficient", b(j++), "force/channel"}); break;
+      case EffectKind::ChannelTimesVelocity:
+        out.push_back({p + "coefficient", b(j++), "force/(channel*position/s)"});
+        break;
+      case EffectKind::SensorDelay:
+      case EffectKind::Backlash: break;
+    }
+  }
+  return out;
+}
+
+std::vector<Parameter> effect_parameters(const std::vector<Parameter>& all, const std::string& name) {
+  std::vector<Parameter> out;
+  for (const auto& p : all)
+    if (p.name.rfind(name + ".", 0) == 0) out.push_back(p);
+  return out;
+}
+
+Vec display_signal(const Context& c, const Spec& s, const std::string& name) {
+  if (name == "sensor_delay" || name == "viscous_friction") return c.v;
+  if (name == "inertia") return c.a;
+  if (name == "temperature_drift") return c.rec.temperature;
+  if (name == "backlash") {
+    const Vec p = play(c.rec.position, s.backlash_width);
+    Vec out(c.n);
+    for (std::size_t k = 0; k < c.n; ++k) out[k] = c.rec.position[k] - p[k];
+    return out;
+  }
+  for (const auto& e : s.columns)
+    if (e.name == name) return column_values(c, e).front();
+  return c.rec.position;
+}
+
+void check(const Recording& rec) {
+  const std::size_t n = rec.time_s.size();
+  if (n < 200) throw std::invalid_argument("analyze: need at least 200 samples, got " + std::to_string(n));
+  auto same = [&](const Vec& v, const char* what, bool optional) {
+    if (optional && v.empty()) return;
+    if (v.size() != n)
+      throw std::invalid_argument(std::string("analyze: ") + what + " has " + std::to_string(v.size()) +
+                                  " samples, time has " + std::to_string(n));
+  };
+  same(rec.position, "position", false);
+  same(rec.force, "force", false);
+  same(rec.truth, "truth", true);
+  same(rec.temperature, "temperature", true);
+  same(rec.velocity, "velocity", true);
+  same(rec.acceleration, "acceleration", true);
+  for (const auto& ch : rec.channels) same(ch.values, ch.name.c_str(), false);
+  for (std::size_t k = 1; k < n; ++k)
+    if (!(rec.time_s[k] > rec.time_s[k - 1]))
+      throw std::invalid_argument("analyze: time is not increasing at sample " + std::to_string(k));
+}
+
+}  // namespace
+
+AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
+  opt.validate();
+  check(rec);
+  Context c(rec, opt);
+  c.n = rec.time_s.size();
+  c.dt = (rec.time_s.back() - rec.time_s.front()) / static_cast<double>(c.n - 1);
+  const auto [mn, mx] = std::minmax_element(rec.position.begin(), rec.position.end());
+  c.xmin = *mn;
+  c.xmax = *mx;
+  c.xrange = c.xmax - c.xmin;
+  if (!(c.xrange > 0.0)) throw std::invalid_argument("analyze: position is constant");
+  c.y = Eigen::Map<const Eigen::VectorXd>(rec.force.data(), static_cast<Index>(c.n));
+  if (!rec.temperature.empty())
+    c.temp_mean = std::accumulate(rec.temperature.begin(), rec.temperature.end(), 0.0) / static_cast<double>(c.n);
+
+  AnalysisResult res;
+  res.samples = c.n;
+  res.dt_s = c.dt;
+  std::ostringstream how;
+  const std::size_t hv = half_width_for(opt.velocity_window_s, c.dt);
+  const std::size_t ha = half_width_for(opt.acceleration_window_s, c.dt);
+  if (rec.velocity.empty()) {
+    c.v = sg_first_derivative(rec.position, c.dt, hv);
+    how << "velocity: centred Savitzky-Golay (quadratic) first derivative of position over " << (2 * hv + 1)
+        << " samples (" << (2 * hv + 1) * c.dt << " s); ";
+  } else {
+    c.v = rec.velocity;
+    how << "velocity: recorded channel; ";
+  }
+  if (rec.acceleration.empty()) {
+    c.a = sg_second_derivative(rec.position, c.dt, ha);
+    how << "acceleration: centred Savitzky-Golay (quadratic) second derivative of position over " << (2 * ha + 1)
+        << " samples (" << (2 * ha + 1) * c.dt << " s)";
+  } else {
+    c.a = rec.acceleration;
+    how << "acceleration: recorded channel";
+  }
+  res.differentiator = how.str();
+
+  // Held-out rows: whole blocks of the recording, split in time.
+  const std::size_t blocks = opt.split == HoldoutSplit::Interleaved ? static_cast<std::size_t>(opt.split_blocks) : 1;
+  std::vector<bool> held(c.n, false);
+  if (opt.split == HoldoutSplit::Interleaved) {
+    const auto h = static_cast<std::size_t>(std::lround(opt.holdout_fraction * static_cast<double>(blocks)));
+    for (std::size_t j = 0; j < std::max<std::size_t>(h, 1); ++j) {
+      const std::size_t b = static_cast<std::size_t>((static_cast<double>(j) + 0.5) * static_cast<double>(blocks) /
+                                                     static_cast<double>(std::max<std::size_t>(h, 1)));
+      for (std::size_t k = c.n * b / blocks; k < c.n * (b + 1) / blocks; ++k) held[k] = true;
+    }
+  } else {
+    const auto start = static_cast<std::size_t>((1.0 - opt.holdout_fraction) * static_cast<double>(c.n));
+    for (std::size_t k = start; k < c.n; ++k) held[k] = true;
+  }
+  for (std::size_t k = 0; k < c.n; ++k) (held[k] ? c.holdout : c.train).push_back(static_cast<Index>(k));
+  res.holdout_samples = c.holdout.size();
+  const std::size_t step = (c.train.size() + static_cast<std::size_t>(opt.search_max_rows) - 1) /
+                           static_cast<std::size_t>(opt.search_max_rows);
+  for (std::size_t k = 0; k < c.train.size(); k += std::max<std::size_t>(step, 1)) c.train_search.push_back(c.train[k]);
+
+  // Baseline: eq. 5 with Delta_max chosen on the fit part.
+  Spec spec;
+  spec.delta_max = choose_delta_max(c, spec);
+  Evaluated cur = [&] {
+    Design d = build(c, spec);
+    Eigen::VectorXd b = fit(c, d, c.train);
+    return evaluate(c, spec, std::move(d), b);
+  }();
+  update_refs(c, cur);
+  res.baseline_delta_max = spec.delta_max;
+  res.baseline_parameters = model_parameters(c, spec, cur);
+  res.baseline = cur.errors;
+  res.residual_before.assign(cur.residual.data(), cur.residual.data() + cur.residual.size());
+  res.truth_error_before = cur.truth_error;
+
+  for (int round = 0; round <= opt.max_steps; ++round) {
+    const auto cands = candidates_for(c, spec);
+    if (cands.empty()) break;
+    std::vector<Scored> scored;
+    for (const auto& cand : cands)
+      scored.push_back(score_candidate(c, spec, cand, cur.residual, cur.errors.holdout_rms_residual));
+    std::sort(scored.begin(), scored.end(),
+              [](const Scored& a, const Scored& b) { return a.score.holdout_rms < b.score.holdout_rms; });
+    std::vector<CandidateScore> scores;
+    for (const auto& s : scored) scores.push_back(s.score);
+    res.rounds.push_back(scores);
+    // The best significant candidate by held-out RMS.
+    const Scored* best = nullptr;
+    for (const auto& s : scored)
+      if (s.score.significant) {
+        best = &s;
+        break;
+      }
+    if (!best || round == opt.max_steps) {
+      res.rejected = scores;
+      if (best) res.structure_notes.push_back("max_steps reached with a significant candidate left");
+      break;
+    }
+    Step st;
+    st.evidence = best->score;
+    for (const auto& s : scored)
+      if (&s != best) {
+        st.runner_up = s.score.name;
+        st.runner_up_relative_drop = s.score.relative_drop;
+        break;
+      }
+    spec = best->spec;
+    spec.delta_max = choose_delta_max(c, spec);
+    // Refit, refresh the curve/friction the columns are built on, and refit once more.
+    for (int pass = 0; pass < 2; ++pass) {
+      Design d = build(c, spec);
+      Eigen::VectorXd b = fit(c, d, c.train);
+      cur = evaluate(c, spec, std::move(d), b);
+      update_refs(c, cur);
+    }
+    st.delta_max = spec.delta_max;
+    st.parameters = effect_parameters(model_parameters(c, spec, cur), best->score.name);
+    st.errors = cur.errors;
+    if (res.steps.empty()) {
+      res.display_regressor_name = best->score.name;
+      res.display_regressor = display_signal(c, spec, best->score.name);
+    }
+    res.steps.push_back(st);
+  }
+  res.final_parameters = model_parameters(c, spec, cur);
+  res.final_errors = cur.errors;
+  res.residual_after.assign(cur.residual.data(), cur.residual.data() + cur.residual.size());
+  res.truth_error_after = cur.truth_error;
+  res.velocity = c.v;
+  if (res.steps.empty()) {
+    res.display_regressor_name = "position";
+    res.display_regressor = rec.position;
+  }
+
+  // Structure left in the final residual.
+  const Vec& r = res.residual_after;
+  const WhitenessTest w = whiteness(r, opt.ljung_box_lags);
+  {
+    StructureFinding f;
+    f.test = "whiteness";
+    f.statistic = w.ljung_box_q;
+    f.critical = w.critical_q;
+    f.effect = w.noise_rms > 0.0 ? w.structured_rms / w.noise_rms : std::numeric_limits<double>::infinity();
+    f.effect_threshold = opt.structure_min_signal_to_noise;
+    f.significant = w.significant;
+    f.flagged = f.significant && f.effect > f.effect_threshold;
+    res.structure.push_back(f);
+  }
+  auto dep = [&](const Vec& by, const std::string& name) {
+    const DependenceTest t = dependence(r, by, opt.structure_bins, name);
+    StructureFinding f;
+    f.test = name;
+    f.statistic = t.f_statistic;
+    f.critical = t.f_critical;
+    f.effect = t.eta2;
+    f.effect_threshold = opt.structure_min_eta2;
+    f.significant = t.significant;
+    f.flagged = f.significant && f.effect > f.effect_threshold;
+    res.structure.push_back(f);
+  };
+  dep(rec.position, "position");
+  dep(rec.time_s, "time");
+  dep(c.v, "velocity");
+  dep(c.a, "acceleration");
+  if (!rec.temperature.empty()) dep(rec.temperature, "temperature");
+  for (const auto& ch : rec.channels) dep(ch.values, "channel:" + ch.name);
+  for (const auto& f : res.structure) {
+    if (!f.flagged) continue;
+    res.unexplained_structure = true;
+    std::ostringstream o;
+    if (f.test == "whiteness")
+      o << "residual is not white: Ljung-Box Q = " << f.statistic << " > " << f.critical
+        << ", predictable part " << f.effect << " x the white-noise level";
+    else
+      o << "residual depends on " << f.test << ": eta^2 = " << f.effect << " (F = " << f.statistic << " > "
+        << f.critical << ")";
+    res.structure_notes.push_back(o.str());
+  }
+  return res;
+}
+
+}  // namespace bbw::analysis

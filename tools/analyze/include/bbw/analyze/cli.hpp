@@ -1,0 +1,40 @@
+// Command line of bbw_analyze and loading of the recording it names.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "bbw/analysis/analysis.hpp"
+
+namespace bbw::analyze {
+
+struct CliArgs {
+  std::string input, out, config;
+  std::string time_col, position_col, force_col, truth_col, temperature_col, velocity_col, acceleration_col;
+  bool channels_given = false;
+  std::vector<std::string> channels;  // "--channels none" gives an empty list
+};
+
+std::string usage();
+// Throws std::invalid_argument naming the offending argument.
+CliArgs parse_args(const std::vector<std::string>& args);
+
+struct LoadedRecording {
+  analysis::Recording rec;
+  std::string file;
+  std::string time_col, position_col, force_col, truth_col, temperature_col, velocity_col, acceleration_col;
+  std::vector<std::string> channel_cols;
+  std::string force_unit, position_unit;
+  std::size_t lines_read = 0, lines_rejected = 0;
+  std::string rejection_summary;
+};
+
+// The unit suffix of a column name ("force_internal_kN" -> "kN", "qm_m" -> "m"), or "" if none.
+std::string unit_from_column(const std::string& column);
+
+// Reads the CSV: required time/position/force, optional truth/temperature/velocity/acceleration;
+// channels default to every other column of the header. Throws on a missing column.
+LoadedRecording load_recording(const CliArgs& a);
+
+}  // namespace bbw::analyze
