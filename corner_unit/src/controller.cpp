@@ -99,7 +99,7 @@ ControllerOutput LocalController::update_position(const PositionReference& ref, 
 }
 
 ControllerOutput LocalController::update_force(double force_command_kN, const ControllerInputs& in,
-                                               double dt_s) {
+                                               double dt_s, double force_rate_kN_per_s) {
   if (!(dt_s > 0.0)) return ControllerOutput{};
   if (force_command_kN <= p_.release_force_kN) {
     s_.releasing = true;
@@ -111,7 +111,7 @@ ControllerOutput LocalController::update_force(double force_command_kN, const Co
   const double k = p_.stiffness_at_zero_kN_per_rev +
                    p_.stiffness_per_kN_per_rev * std::max(in.force_feedback_kN, 0.0);
   const double unclipped =
-      (p_.force_bandwidth_rad_per_s * e + p_.force_integral_rad_per_s2 * s_.force_integral_kN_s) / k;
+      (force_rate_kN_per_s + p_.force_bandwidth_rad_per_s * e + p_.force_integral_rad_per_s2 * s_.force_integral_kN_s) / k;
   const double v_ref = std::clamp(unclipped, -p_.max_speed_rev_per_s, p_.max_speed_rev_per_s);
   ControllerOutput out = speed_loop(v_ref, 0.0, in, dt_s);
   const bool clipped = v_ref != unclipped || out.saturated;

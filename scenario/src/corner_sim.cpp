@@ -74,7 +74,14 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
   corner_unit::ControllerOutput out;
   const bool force_mode = ext.force_command_kN.has_value() || mode_ != DriveMode::Position;
   if (force_mode) {
-    const double cmd = ext.force_command_kN ? *ext.force_command_kN : force_scale_ * force_profile_->at(t_next).value;
+    double cmd = 0.0, rate = 0.0;
+    if (ext.force_command_kN) {
+      cmd = *ext.force_command_kN;
+    } else {
+      const Reference r = force_profile_->at(t_next);
+      cmd = force_scale_ * r.value;
+      rate = force_scale_ * r.rate;
+    }
     corner_unit::ForceSources src;
     src.load_cell_kN = m.force_internal_kN;
     src.friction_estimate_kN = ext.friction_estimate_kN;
@@ -82,7 +89,7 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
     src.true_kN = plant_.state().force_true_kN;
     const auto fb = mode_ == DriveMode::Position ? corner_unit::ForceFeedback::LoadCell : feedback_;
     in.force_feedback_kN = corner_unit::select_force(fb, src);
-    out = controller_.update_force(cmd, in, dt_s);
+    out = controller_.update_force(cmd, in, dt_s, rate);
     sample_.command_kind = CommandKind::Force;
     sample_.command = cmd;
   } else {

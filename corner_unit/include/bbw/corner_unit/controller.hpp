@@ -2,7 +2,7 @@
 // motor current command, with a current limit and anti-windup. Pure: time is an argument.
 //
 //   position mode: v_ref = v_ff + Kx (x_ref - x)                          (test rig)
-//   force mode:    v_ref = (wf e + wi * integral(e)) / k(F),  e = F_ref - F_fb,
+//   force mode:    v_ref = (dF_ref/dt + wf e + wi * integral(e)) / k(F),  e = F_ref - F_fb,
 //                  k(F) = stiffness_at_zero + stiffness_per_kN * F      (vehicle)
 //                  below release_force_kN the controller returns to release_position_rev.
 //   speed loop:    i = Kv (v_ref - v) + Ki integral(v_ref - v) + i_load(F_load) + i_acc(a_ff)
@@ -81,7 +81,9 @@ class LocalController {
 
   void reset();
   ControllerOutput update_position(const PositionReference& ref, const ControllerInputs& in, double dt_s);
-  ControllerOutput update_force(double force_command_kN, const ControllerInputs& in, double dt_s);
+  // force_rate_kN_per_s: the command's rate of change if known (feedforward), else 0.
+  ControllerOutput update_force(double force_command_kN, const ControllerInputs& in, double dt_s,
+                                double force_rate_kN_per_s = 0.0);
 
   const ControllerState& state() const { return s_; }
   const ControllerParams& params() const { return p_; }

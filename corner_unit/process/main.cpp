@@ -1,0 +1,146 @@
+// bbw_corner: one e-caliper process (plant, sensors, local controller) over Fast DDS.
+//
+//   bbw_corner --corner FL|FR|RL|RR --scenario FILE [--domain N] [--mode lockstep|realtime]
+//              [--stats FILE] [--discovery-timeout S] [--peer-timeout S]
+//              [--dds-profiles FILE.xml] [--dds-participant-profile NAME]
+//
+// Exit: 0 done (or stopped by SIGINT/SIGTERM: 130/143), 1 runtime or DDS error, 2 bad
+// arguments or config, 3 CCU not discovered in time, 4 CCU lost (no command in time).
+#include <csignal>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <string>
+
+#include "bbw/common/strict_yaml.hpp"
+#include "bbw/dds/domain.hpp"
+#include "bbw/launch/signals.hpp"
+#include "bbw/launch/stats_file.hpp"
+#include "bbw/scenario/load.hpp"
+#include "corner_app.hpp"
+
+namespace {
+
+const char* kUsage =
+    "usage: bbw_corner --corner FL|FR|RL|RR --scenario FILE [--domain N] [--mode lockstep|realtime]\n"
+    "                  [--stats FILE] [--discovery-timeout S] [--peer-timeout S]\n"
+    "                  [--dds-profiles FILE.xml] [--dds-participant-profile NAME]\n";
+
+std::chrono::milliseconds seconds_arg(const std::string& key, const std::string& v) {
+  char* end = nullptr;
+  const double s = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end != '\0' || !(s > 0.0) || s > 3600.0) {
+    throw std::invalid_argument(key + " must be a number of seconds in (0, 3600], got '" + v + "'");
+  }
+  return std::chrono::milliseconds(static_cast<long long>(s * 1000.0));
+}
+
+void write_stats(const std::string& file, const char* corner, const bbw::corner_process::CornerStats& s) {
+  bbw::launch::StatsWriter w;
+  w.set("corner", std::string(corner));
+  w.set("periods", s.periods);
+  w.set("samples_published", s.samples_published);
+  w.set("blocks_published", s.blocks_published);
+  w.set("write_failures", s.write_failures);
+  w.set("commands_received", s.commands_received);
+  w.set("commands_applied", s.commands_applied);
+  w.set("command_seq_gaps", s.command_seq_gaps);
+  w.set("calibrations_applied", s.calibrations_applied);
+  w.set("calibrations_rejected", s.calibrations_rejected);
+  w.set("overruns", s.overruns);
+  w.set("max_jitter_s", s.max_jitter_s);
+  w.set("mean_jitter_s", s.mean_jitter_s);
+  w.set("command_deadlines_missed", s.command_deadlines_missed);
+  w.set("wall_s", s.wall_s);
+  w.save(file);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace bbw::corner_process;
+  bbw::dds::Events events;
+  bbw::launch::SignalWatcher signals([&](int) { events.interrupt(); });
+
+  CornerOptions opt;
+  std::string corner_arg, scenario_file, mode = "lockstep";
+  std::optional<std::string> domain_arg;
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string k = argv[i];
+      auto next = [&]() -> std::string {
+        if (i + 1 >= argc) throw std::invalid_argument("missing value after " + k);
+        return argv[++i];
+      };
+      if (k == "--corner") corner_arg = next();
+      else if (k == "--scenario") scenario_file = next();
+      else if (k == "--domain") domain_arg = next();
+      else if (k == "--mode") mode = next();
+      else if (k == "--stats") opt.stats_file = next();
+      else if (k == "--discovery-timeout") opt.discovery_timeout = seconds_arg(k, next());
+      else if (k == "--peer-timeout") opt.peer_timeout = seconds_arg(k, next());
+      else if (k == "--dds-profiles") opt.participant.profiles_file = next();
+      else if (k == "--dds-participant-profile") opt.participant.profile = next();
+      else if (k == "-h" || k == "--help") { std::cout << kUsage; return 0; }
+      else throw std::invalid_argument("unknown argument '" + k + "'");
+    }
+    if (corner_arg.empty()) throw std::invalid_argument("--corner is required");
+    if (scenario_file.empty()) throw std::invalid_argument("--scenario is required");
+    const auto corner = bbw::dds::parse_corner(corner_arg);
+    if (!corner) throw std::invalid_argument("unknown corner '" + corner_arg + "' (expected FL, FR, RL or RR)");
+    opt.corner = *corner;
+    if (mode == "lockstep") opt.mode = ClockMode::Lockstep;
+    else if (mode == "realtime") opt.mode = ClockMode::Realtime;
+    else throw std::invalid_argument("--mode must be lockstep or realtime, got '" + mode + "'");
+    opt.participant.domain_id = bbw::dds::resolve_domain_id(domain_arg, std::getenv("BBW_DOMAIN"));
+  } catch (const std::exception& e) {
+    std::cerr << "bbw_corner: " << e.what() << "\n" << kUsage;
+    return kExitUsage;
+  }
+
+  // Config is loaded and validated before any DDS entity exists.
+  std::optional<bbw::scenario::Scenario> scenario;
+  try {
+    scenario = bbw::scenario::load_scenario(scenario_file);
+    bool found = false;
+    for (std::size_t i = 0; i < scenario->corners.size(); ++i) {
+      if (scenario->corners[i].name == corner_arg) {
+        opt.scenario_index = i;
+        found = true;
+      }
+    }
+    if (!found) {
+      std::string names;
+      for (const auto& c : scenario->corners) names += (names.empty() ? "" : ", ") + c.name;
+      throw std::invalid_argument(scenario_file + ": has no corner " + corner_arg + " (it has " + names + ")");
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "bbw_corner " << corner_arg << ": " << e.what() << "\n";
+    return kExitUsage;
+  }
+
+  int rc = kExitOk;
+  std::string error;
+  try {
+    CornerApp app(*scenario, opt, events);
+    std::cout << "bbw_corner " << corner_arg << ": domain " << opt.participant.domain_id << ", mode " << mode
+              << ", scenario " << scenario->name << std::endl;
+    rc = app.run(error);
+    if (!opt.stats_file.empty()) write_stats(opt.stats_file, corner_arg.c_str(), app.stats());
+    std::cout << "bbw_corner " << corner_arg << ": " << app.stats().periods << " periods, "
+              << app.stats().samples_published << " samples published" << std::endl;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "bbw_corner " << corner_arg << ": " << e.what() << "\n";
+    return kExitUsage;
+  } catch (const std::exception& e) {
+    std::cerr << "bbw_corner " << corner_arg << ": " << e.what() << "\n";
+    return kExitRuntime;
+  }
+  if (rc != kExitOk) {
+    std::cerr << "bbw_corner " << corner_arg << ": " << error << "\n";
+    return rc;
+  }
+  if (const int sig = signals.received(); sig != 0) return 128 + sig;
+  return kExitOk;
+}
