@@ -1,0 +1,79 @@
+#include "bbw/dds/convert.hpp"
+
+#include <cmath>
+
+namespace bbw::dds {
+
+void to_msg(const scenario::CornerSample& in, bool force_comp_used, msg::MeasurementSample& out) {
+  out.seq(in.seq);
+  out.time_s(in.time_s);
+  out.position_rev(in.position_rev);
+  out.speed_rev_s(in.speed_rev_s);
+  out.force_internal_kN(in.force_internal_kN);
+  out.force_external_kN(in.force_external_kN);
+  out.force_true_kN(in.force_true_kN);
+  out.temperature_C(in.temperature_C);
+  out.motor_current_A(in.motor_current_A);
+  out.command(in.command);
+  std::uint32_t status = msg::STATUS_SIM_TRUTH_VALID | msg::STATUS_EXTERNAL_VALID;
+  if (in.command_kind == scenario::CommandKind::Force) status |= msg::STATUS_FORCE_MODE;
+  if (force_comp_used) status |= msg::STATUS_FRICTION_COMP;
+  out.status(status);
+}
+
+calibration::Sample to_calibration_sample(const msg::MeasurementSample& in) {
+  calibration::Sample s;
+  s.time_s = in.time_s();
+  s.position_rev = in.position_rev();
+  s.force_kN = in.force_internal_kN();
+  return s;
+}
+
+bool is_finite(const msg::MeasurementSample& in) {
+  for (double v : {in.time_s(), in.position_rev(), in.speed_rev_s(), in.force_internal_kN(),
+                   in.force_external_kN(), in.force_true_kN(), in.temperature_C(),
+                   in.motor_current_A(), in.command()}) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
+void to_msg(const calibration::Calibrator& calibrator, std::uint8_t corner_id, std::uint64_t version,
+            double time_s, msg::CalibrationState& out) {
+  const auto& c = calibrator.curve();
+  const auto& f = calibrator.friction();
+  const auto& st = calibrator.stats();
+  out.corner_id(corner_id);
+  out.version(version);
+  out.time_s(time_s);
+  out.curve_a_kN_per_rev3(c.a);
+  out.curve_b_kN_per_rev2(c.b);
+  out.curve_c_kN_per_rev(c.c);
+  out.curve_d_kN(c.d);
+  out.friction_delta_rev(f.delta_rev);
+  out.friction_stiffness_kN_per_rev(f.stiffness_kN_per_rev);
+  out.fits_accepted(st.fits_accepted);
+  out.fits_rejected(st.fits_rejected);
+  out.cycles_detected(st.cycles_detected);
+  out.last_fit_rms_kN(st.last_fit_rms_kN);
+  out.last_fit_span_rev(st.last_fit_span_rev);
+}
+
+bool from_msg(const msg::CalibrationState& in, CalibrationModel& out) {
+  const auto& d = in.friction_delta_rev();
+  const auto& k = in.friction_stiffness_kN_per_rev();
+  if (d.size() != k.size()) return false;
+  for (double v : {in.curve_a_kN_per_rev3(), in.curve_b_kN_per_rev2(), in.curve_c_kN_per_rev(), in.curve_d_kN()}) {
+    if (!std::isfinite(v)) return false;
+  }
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    if (!std::isfinite(d[i]) || !(d[i] > 0.0) || !std::isfinite(k[i])) return false;
+  }
+  out.curve = {in.curve_a_kN_per_rev3(), in.curve_b_kN_per_rev2(), in.curve_c_kN_per_rev(), in.curve_d_kN()};
+  out.delta_rev.assign(d.begin(), d.end());
+  out.stiffness_kN_per_rev.assign(k.begin(), k.end());
+  out.version = in.version();
+  return true;
+}
+
+}  // namespace bbw::dds
