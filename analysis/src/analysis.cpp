@@ -32,6 +32,7 @@ struct ColumnEffect {
 // extra columns.
 struct Spec {
   double delta_max = 0.0;
+  std::vector<double> knots;  // interior spline knots in scaled position; empty: eq. 5 cubic
   bool has_delay = false;
   double delay_s = 0.0;
   bool has_backlash = false;
@@ -55,12 +56,12 @@ struct Context {
   double dt = 0.0;
   double xmin = 0.0, xmax = 0.0, xrange = 0.0;
   Vec v, a;
-  double temp_mean = 0.0;
+  double temp_ref = 0.0;
   Eigen::VectorXd y;
   std::vector<Index> train, train_search, holdout;
   // From the last accepted fit: the curve and the friction, for columns built on them.
-  Vec ref_curve, ref_friction;
-  double ref_curve_scale = 1.0;
+  Vec ref_curve, ref_friction, ref_slope;
+  double ref_curve_scale = 1.0, ref_slope_scale = 1.0;
 };
 
 double rms_of(const Eigen::VectorXd& r, const std::vector<Index>& rows) {
@@ -80,12 +81,14 @@ std::vector<Vec> column_values(const Context& c, const ColumnEffect& e) {
       return {col};
     }
     case EffectKind::TemperatureDrift: {
-      Vec off(n), gain(n);
+      // Load-cell offset (sensor), curve gain and curve shift (true force) with temperature.
+      Vec off(n), gain(n), shift(n);
       for (std::size_t k = 0; k < n; ++k) {
-        off[k] = c.rec.temperature[k] - c.temp_mean;
+        off[k] = c.rec.temperature[k] - c.temp_ref;
         gain[k] = off[k] * c.ref_curve[k] / c.ref_curve_scale;
+        shift[k] = off[k] * c.ref_slope[k] / c.ref_slope_scale;
       }
-      return {off, gain};
+      return {off, gain, shift};
     }
     case EffectKind::Creep: return {creep_regressor(c.ref_curve, c.dt, e.hyper)};
     case EffectKind::Channel: return {c.rec.channels[static_cast<std::size_t>(e.channel)].values};
@@ -117,7 +120,8 @@ Design build(const Context& c, const Spec& s) {
   std::vector<Vec> nreg;
   maxwell_slip_regressors(d.x_eff, d.deltas, nreg);
   std::vector<std::vector<Vec>> extra;
-  std::size_t p = 4 + m;
+  const std::size_t nc = 4 + s.knots.size();
+  std::size_t p = nc + m;
   for (const auto& e : s.columns) {
     extra.push_back(column_values(c, e));
     p += extra.back().size();
@@ -132,12 +136,16 @@ Design build(const Context& c, const Spec& s) {
     d.x(r, 1) = sx;
     d.x(r, 2) = sx * sx;
     d.x(r, 3) = sx * sx * sx;
+    for (std::size_t j = 0; j < s.knots.size(); ++j) {
+      const double u = std::max(0.0, sx - s.knots[j]);
+      d.x(r, static_cast<Index>(4 + j)) = u * u * u;
+    }
   }
-  for (int j = 0; j < 4; ++j) {
+  for (std::size_t j = 0; j < nc; ++j) {
     d.nonneg.push_back(false);
     d.owner.push_back(-2);
   }
-  Index col = 4;
+  auto col = static_cast<Index>(nc);
   for (std::size_t i = 0; i < m; ++i, ++col) {
     for (std::size_t k = 0; k < c.n; ++k) d.x(static_cast<Index>(k), col) = nreg[i][k];
     d.nonneg.push_back(true);
@@ -182,7 +190,14 @@ Evaluated evaluate(const Context& c, const Spec& s, Design d, const Eigen::Vecto
     Eigen::VectorXd sensor = Eigen::VectorXd::Zero(static_cast<Index>(c.n));
     for (Index j = 0; j < d.x.cols(); ++j) {
       const int o = d.owner[static_cast<std::size_t>(j)];
-      const bool is_sensor = o == -1 || (o >= 0 && c.opt.is_sensor_effect(to_string(s.columns[static_cast<std::size_t>(o)].kind)));
+      bool is_sensor = o == -1;
+      if (o >= 0) {
+        const EffectKind kind = s.columns[static_cast<std::size_t>(o)].kind;
+        is_sensor = c.opt.is_sensor_effect(to_string(kind));
+        // Of the temperature columns only the first (load-cell offset) belongs to the sensor;
+        // the curve's gain and shift with temperature are changes of the true force.
+        if (kind == EffectKind::TemperatureDrift && j > 0 && d.owner[static_cast<std::size_t>(j - 1)] == o) is_sensor = false;
+      }
       if (is_sensor) sensor += d.x.col(j) * coef(j);
     }
     // A sensor delay means the reading at t belongs to the true force at t - delay.
@@ -223,6 +238,37 @@ double choose_delta_max(const Context& c, Spec s) {
   return best_dm;
 }
 
+// Chooses the curve's knots (fewest within tolerance of the best held-out RMS) and Delta_max
+// (fit-part RMS) for the model `s` otherwise as it is.
+void choose_curve(const Context& c, Spec& spec) {
+  std::vector<double> sorted = c.rec.position;
+  std::sort(sorted.begin(), sorted.end());
+  auto knots_for = [&](int nk) {
+    std::vector<double> k;
+    for (int j = 1; j <= nk; ++j) {
+      const double q = sorted[static_cast<std::size_t>(static_cast<double>(c.n - 1) * j / (nk + 1))];
+      k.push_back((2.0 * q - (c.xmax + c.xmin)) / c.xrange);
+    }
+    return k;
+  };
+  std::vector<std::pair<Spec, double>> scores;
+  for (int nk : c.opt.curve_knots_grid) {
+    Spec t = spec;
+    t.knots = knots_for(nk);
+    t.delta_max = choose_delta_max(c, t);
+    const Design d = build(c, t);
+    const double r = rms_of(c.y - d.x * fit(c, d, c.train), c.holdout);
+    scores.emplace_back(t, r);
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& sc : scores) best = std::min(best, sc.second);
+  for (const auto& sc : scores)
+    if (sc.second <= (1.0 + c.opt.curve_knots_tolerance) * best) {
+      spec = sc.first;
+      return;
+    }
+}
+
 void update_refs(Context& c, const Evaluated& ev) {
   const Design& d = ev.design;
   c.ref_curve.assign(c.n, 0.0);
@@ -236,24 +282,45 @@ void update_refs(Context& c, const Evaluated& ev) {
   double mx = 0.0;
   for (double v : c.ref_curve) mx = std::max(mx, std::abs(v));
   c.ref_curve_scale = mx > 0.0 ? mx : 1.0;
+  // Slope of the curve along the effective position (d curve / d x), for the temperature shift.
+  const double half = 0.5 * c.xrange;
+  c.ref_slope.assign(c.n, 0.0);
+  const std::size_t nk = static_cast<std::size_t>(d.x.cols());
+  for (std::size_t k = 0; k < c.n; ++k) {
+    const double sx = d.x(static_cast<Index>(k), 1);
+    double g = ev.coef(1) + 2.0 * ev.coef(2) * sx + 3.0 * ev.coef(3) * sx * sx;
+    for (std::size_t j = 4; j < nk && d.owner[j] == -2; ++j) {
+      const double u = d.x(static_cast<Index>(k), static_cast<Index>(j));  // (s - knot)_+^3
+      g += 3.0 * ev.coef(static_cast<Index>(j)) * std::cbrt(u * u);
+    }
+    c.ref_slope[k] = g / half;
+  }
+  mx = 0.0;
+  for (double v : c.ref_slope) mx = std::max(mx, std::abs(v));
+  c.ref_slope_scale = mx > 0.0 ? mx : 1.0;
 }
 
+// Consistency of the held-out improvement: the held-out samples are cut into `blocks` contiguous
+// chunks; t is the one-sample t statistic of log(MSE_old / MSE_new) over the chunks. The log ratio
+// is scale-free, so chunks with large and small errors weigh alike, and a candidate that only fits
+// noise improves some chunks and worsens others (mean near or below zero).
 double paired_t(const Eigen::VectorXd& r_old, const Eigen::VectorXd& r_new, const std::vector<Index>& rows, int blocks) {
   const std::size_t nb = static_cast<std::size_t>(blocks);
   if (rows.size() < nb * 2) return 0.0;
-  Vec means(nb, 0.0);
+  Vec logs(nb, 0.0);
   for (std::size_t b = 0; b < nb; ++b) {
     const std::size_t lo = rows.size() * b / nb, hi = rows.size() * (b + 1) / nb;
-    double s = 0.0;
+    double so = 0.0, sn = 0.0;
     for (std::size_t k = lo; k < hi; ++k) {
       const Index i = rows[k];
-      s += r_old(i) * r_old(i) - r_new(i) * r_new(i);
+      so += r_old(i) * r_old(i);
+      sn += r_new(i) * r_new(i);
     }
-    means[b] = s / static_cast<double>(hi - lo);
+    logs[b] = std::log((so + 1e-300) / (sn + 1e-300));
   }
-  const double m = std::accumulate(means.begin(), means.end(), 0.0) / static_cast<double>(nb);
+  const double m = std::accumulate(logs.begin(), logs.end(), 0.0) / static_cast<double>(nb);
   double var = 0.0;
-  for (double x : means) var += (x - m) * (x - m);
+  for (double x : logs) var += (x - m) * (x - m);
   var /= static_cast<double>(nb - 1);
   if (var <= 0.0) return m > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
   return m / std::sqrt(var / static_cast<double>(nb));
@@ -361,21 +428,28 @@ std::vector<Parameter> model_parameters(const Context& c, const Spec& s, const E
   const Eigen::VectorXd& b = ev.coef;
   const double al = 2.0 / c.xrange;
   const double be = -(c.xmax + c.xmin) / c.xrange;
+  // A..D: the cubic part (the whole curve when there are no knots).
   out.push_back({"A", b(3) * al * al * al, "force/position^3"});
   out.push_back({"B", (b(2) + 3.0 * b(3) * be) * al * al, "force/position^2"});
   out.push_back({"C", (b(1) + 2.0 * b(2) * be + 3.0 * b(3) * be * be) * al, "force/position"});
   out.push_back({"D", b(0) + b(1) * be + b(2) * be * be + b(3) * be * be * be, "force"});
+  const std::size_t nc = 4 + s.knots.size();
+  for (std::size_t j = 0; j < s.knots.size(); ++j) {
+    out.push_back({"knot_" + std::to_string(j + 1), (s.knots[j] - be) / al, "position"});
+    out.push_back({"knot_" + std::to_string(j + 1) + "_cubic", b(static_cast<Index>(4 + j)) * al * al * al,
+                   "force/position^3"});
+  }
   out.push_back({"Delta_max", s.delta_max, "position"});
   double bound = 0.0;
-  for (std::size_t i = 0; i < ev.design.deltas.size(); ++i) bound += b(static_cast<Index>(4 + i));
+  for (std::size_t i = 0; i < ev.design.deltas.size(); ++i) bound += b(static_cast<Index>(nc + i));
   out.push_back({"friction_bound", bound, "force"});  // sum K_i Delta_i: the Coulomb-like level
   for (std::size_t i = 0; i < ev.design.deltas.size(); ++i) {
     const double delta = ev.design.deltas[i];
-    out.push_back({"K_" + std::to_string(i + 1), b(static_cast<Index>(4 + i)) / delta, "force/position"});
+    out.push_back({"K_" + std::to_string(i + 1), b(static_cast<Index>(nc + i)) / delta, "force/position"});
   }
   if (s.has_delay) out.push_back({"sensor_delay.delay_s", s.delay_s, "s"});
   if (s.has_backlash) out.push_back({"backlash.width", s.backlash_width, "position"});
-  Index j = 4 + static_cast<Index>(ev.design.deltas.size());
+  Index j = static_cast<Index>(nc + ev.design.deltas.size());
   for (const auto& e : s.columns) {
     const std::string p = e.name + ".";
     switch (e.kind) {
@@ -385,9 +459,10 @@ std::vector<Parameter> model_parameters(const Context& c, const Spec& s, const E
         out.push_back({p + "friction_gain_at_full_curve", b(j++), "1"});
         break;
       case EffectKind::TemperatureDrift:
-        out.push_back({p + "offset_per_degC", b(j++), "force/degC"});
-        out.push_back({p + "gain_at_full_curve_per_degC", b(j++) / c.ref_curve_scale, "force/degC per force"});
-        out.push_back({p + "reference_temperature", c.temp_mean, "degC"});
+        out.push_back({p + "sensor_offset_per_degC", b(j++), "force/degC"});
+        out.push_back({p + "curve_gain_per_degC", b(j++) / c.ref_curve_scale, "1/degC"});
+        out.push_back({p + "curve_shift_per_degC", -b(j++) / c.ref_slope_scale, "position/degC"});
+        out.push_back({p + "reference_temperature_C", c.temp_ref, "degC"});
         break;
       case EffectKind::Creep:
         out.push_back({p + "tau_s", e.hyper, "s"});
@@ -461,8 +536,15 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
   c.xrange = c.xmax - c.xmin;
   if (!(c.xrange > 0.0)) throw std::invalid_argument("analyze: position is constant");
   c.y = Eigen::Map<const Eigen::VectorXd>(rec.force.data(), static_cast<Index>(c.n));
-  if (!rec.temperature.empty())
-    c.temp_mean = std::accumulate(rec.temperature.begin(), rec.temperature.end(), 0.0) / static_cast<double>(c.n);
+  if (!rec.temperature.empty()) {
+    if (std::isfinite(opt.temperature_reference_C)) {
+      c.temp_ref = opt.temperature_reference_C;
+    } else {  // the load cell is taken as tared at the start: median of the first 100 samples
+      std::vector<double> first(rec.temperature.begin(), rec.temperature.begin() + std::min<std::ptrdiff_t>(100, static_cast<std::ptrdiff_t>(c.n)));
+      std::nth_element(first.begin(), first.begin() + static_cast<std::ptrdiff_t>(first.size() / 2), first.end());
+      c.temp_ref = first[first.size() / 2];
+    }
+  }
 
   AnalysisResult res;
   res.samples = c.n;
@@ -502,7 +584,18 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
     const auto start = static_cast<std::size_t>((1.0 - opt.holdout_fraction) * static_cast<double>(c.n));
     for (std::size_t k = start; k < c.n; ++k) held[k] = true;
   }
-  for (std::size_t k = 0; k < c.n; ++k) (held[k] ? c.holdout : c.train).push_back(static_cast<Index>(k));
+  double train_lo = std::numeric_limits<double>::infinity(), train_hi = -train_lo;
+  for (std::size_t k = 0; k < c.n; ++k)
+    if (!held[k]) {
+      train_lo = std::min(train_lo, rec.position[k]);
+      train_hi = std::max(train_hi, rec.position[k]);
+    }
+  for (std::size_t k = 0; k < c.n; ++k) {
+    if (!held[k]) c.train.push_back(static_cast<Index>(k));
+    else if (rec.position[k] >= train_lo && rec.position[k] <= train_hi) c.holdout.push_back(static_cast<Index>(k));
+  }
+  if (c.holdout.size() < static_cast<std::size_t>(4 * opt.significance_blocks))
+    throw std::invalid_argument("analyze: too few held-out samples inside the fit part's position range");
   res.holdout_samples = c.holdout.size();
   const std::size_t step = (c.train.size() + static_cast<std::size_t>(opt.search_max_rows) - 1) /
                            static_cast<std::size_t>(opt.search_max_rows);
@@ -510,7 +603,9 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
 
   // Baseline: eq. 5 with Delta_max chosen on the fit part.
   Spec spec;
-  spec.delta_max = choose_delta_max(c, spec);
+  choose_curve(c, spec);
+  res.curve_knots = static_cast<int>(spec.knots.size());
+
   Evaluated cur = [&] {
     Design d = build(c, spec);
     Eigen::VectorXd b = fit(c, d, c.train);
@@ -555,7 +650,7 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
         break;
       }
     spec = best->spec;
-    spec.delta_max = choose_delta_max(c, spec);
+    choose_curve(c, spec);
     // Refit, refresh the curve/friction the columns are built on, and refit once more.
     for (int pass = 0; pass < 2; ++pass) {
       Design d = build(c, spec);
@@ -564,6 +659,7 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
       update_refs(c, cur);
     }
     st.delta_max = spec.delta_max;
+    st.curve_knots = static_cast<int>(spec.knots.size());
     st.parameters = effect_parameters(model_parameters(c, spec, cur), best->score.name);
     st.errors = cur.errors;
     if (res.steps.empty()) {

@@ -55,6 +55,14 @@ void known_names(const std::string& field, const std::vector<std::string>& v) {
 }  // namespace
 
 void AnalysisOptions::validate() const {
+  if (curve_knots_grid.empty()) bad("curve_knots_grid", "[]", "must not be empty");
+  for (std::size_t i = 0; i < curve_knots_grid.size(); ++i) {
+    const int k = curve_knots_grid[i];
+    if (k < 0 || k > 30) bad("curve_knots_grid", k, "entries must be in [0, 30]");
+    if (i > 0 && k <= curve_knots_grid[i - 1]) bad("curve_knots_grid", k, "entries must be increasing");
+  }
+  if (!(curve_knots_tolerance >= 0.0 && curve_knots_tolerance < 1.0))
+    bad("curve_knots_tolerance", curve_knots_tolerance, "must be in [0, 1)");
   if (elements_M < 1 || elements_M > 64) bad("elements_M", elements_M, "must be in [1, 64]");
   if (!(geometric_ratio > 0.0 && geometric_ratio <= 1.0)) bad("geometric_ratio", geometric_ratio, "must be in (0, 1]");
   positive_grid("delta_max_fractions", delta_max_fractions, false);

@@ -1,5 +1,6 @@
 #include "bbw/analyze/config_loader.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace bbw::analyze {
@@ -9,6 +10,14 @@ using config::Range;
 analysis::AnalysisOptions load_options(config::Reader& r) {
   analysis::AnalysisOptions o;
   if (auto m = r.optional_map("baseline")) {
+    if (m->has("curve_knots_grid")) {
+      o.curve_knots_grid.clear();
+      for (double k : m->numbers("curve_knots_grid", Range::closed(0, 30))) {
+        if (k != std::floor(k)) m->fail("curve_knots_grid", "entries must be whole numbers");
+        o.curve_knots_grid.push_back(static_cast<int>(k));
+      }
+    }
+    o.curve_knots_tolerance = m->number_or("curve_knots_tolerance", o.curve_knots_tolerance, Range{0.0, 1.0, false, true});
     o.elements_M = static_cast<int>(m->integer_or("elements_M", o.elements_M, 1, 64));
     o.geometric_ratio = m->number_or("geometric_ratio", o.geometric_ratio, Range{0.0, 1.0, true, false});
     if (m->has("delta_max_fractions")) o.delta_max_fractions = m->numbers("delta_max_fractions", Range::positive());
@@ -59,6 +68,8 @@ analysis::AnalysisOptions load_options(config::Reader& r) {
     o.sensor_effects = sensor;
     m->finish();
   }
+  if (r.has("temperature_reference_C"))
+    o.temperature_reference_C = r.number("temperature_reference_C", Range::closed(-60.0, 200.0));
   if (auto m = r.optional_map("structure")) {
     o.ljung_box_lags = static_cast<int>(m->integer_or("ljung_box_lags", o.ljung_box_lags, 1, 1000));
     o.structure_bins = static_cast<int>(m->integer_or("bins", o.structure_bins, 2, 1000));

@@ -95,6 +95,7 @@ std::string analysis_json(const LoadedRecording& in, const analysis::AnalysisOpt
   for (const auto& s : o.sensor_effects) w.value("", s);
   w.end_array();
   w.end_object();
+  w.value("curve_knots", r.curve_knots);
   w.value("baseline_delta_max", r.baseline_delta_max);
   params_json(w, "baseline_parameters", r.baseline_parameters);
   errors_json(w, "baseline", r.baseline, in.force_unit);
@@ -110,6 +111,7 @@ std::string analysis_json(const LoadedRecording& in, const analysis::AnalysisOpt
     w.end_object();
     params_json(w, "parameters", s.parameters);
     w.value("delta_max", s.delta_max);
+    w.value("curve_knots", s.curve_knots);
     errors_json(w, "errors_after", s.errors, in.force_unit);
     w.end_object();
   }
@@ -223,7 +225,7 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
   if (truth) md << ", truth `" << in.truth_col << "`";
   md << ". Held out: " << r.holdout_samples << " samples ("
      << (o.split == analysis::HoldoutSplit::Interleaved ? "interleaved blocks" : "tail") << ").\n\n";
-  md << "Baseline: eq. 5 with M = " << o.elements_M << " geometric elements, Delta_max = " << fmt(r.baseline_delta_max)
+  md << "Baseline: eq. 5 with " << (r.curve_knots == 0 ? std::string("a cubic curve") : "a cubic-spline curve with " + std::to_string(r.curve_knots) + " interior knots") << ", M = " << o.elements_M << " geometric elements, Delta_max = " << fmt(r.baseline_delta_max)
      << " (chosen by fit-part RMS). " << r.differentiator << ".\n\n";
   md << "| | RMS residual | max residual | held-out RMS |" << (truth ? " RMS error vs truth | max error vs truth |" : "")
      << "\n|---|---|---|---|" << (truth ? "---|---|" : "") << "\n";

@@ -60,6 +60,7 @@ struct Step {
   double runner_up_relative_drop = 0.0;
   std::vector<Parameter> parameters;  // the effect's own fitted parameters
   double delta_max = 0.0;             // re-chosen after the step
+  int curve_knots = 0;                // re-chosen after the step
   ErrorFigures errors;
 };
 
@@ -79,6 +80,7 @@ struct AnalysisResult {
   std::size_t holdout_samples = 0;
   std::string differentiator;  // how velocity and acceleration were obtained
 
+  int curve_knots = 0;  // 0: the eq. 5 cubic; else interior knots of the cubic spline
   double baseline_delta_max = 0.0;
   std::vector<Parameter> baseline_parameters;  // A..D (position units), K_i, Delta_i
   ErrorFigures baseline;

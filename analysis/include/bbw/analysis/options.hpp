@@ -1,6 +1,7 @@
 // Settings of the residual analysis. Plain struct; validate() names the field, value and rule.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -11,7 +12,7 @@ enum class EffectKind {
   ViscousFriction,        // column: velocity
   LoadDependentFriction,  // column: fitted friction x fitted curve / max|curve|
   SensorDelay,            // position delayed by tau before every position regressor; tau searched
-  TemperatureDrift,       // columns: (T - mean T) and (T - mean T) x curve level
+  TemperatureDrift,       // columns: (T - T_ref), (T - T_ref) x curve level, (T - T_ref) x curve slope
   Backlash,               // position through a play operator of width w before the model; w searched
   Creep,                  // column: curve - lag_tau(curve); tau searched
   Inertia,                // column: acceleration
@@ -29,16 +30,23 @@ enum class HoldoutSplit {
 };
 
 struct AnalysisOptions {
-  // Eq. 5 baseline.
+  // Eq. 5 baseline. The curve is a cubic (eq. 5) when it has no knots; with knots it is a C2
+  // cubic spline (the global counterpart of the calibrator's per-cycle local cubics). The
+  // number of interior knots (placed at position quantiles) is chosen from curve_knots_grid:
+  // the fewest knots whose held-out RMS is within curve_knots_tolerance of the best.
+  std::vector<int> curve_knots_grid = {0, 1, 2, 3, 4, 6, 8};
+  double curve_knots_tolerance = 0.02;
   int elements_M = 8;
   double geometric_ratio = 0.6;  // Delta_{i-1} = ratio * Delta_i, Delta_M = Delta_max
   // Delta_max grid, as fractions of the position range; chosen by fit-part RMS.
   std::vector<double> delta_max_fractions = {0.002, 0.005, 0.01, 0.02, 0.035, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3};
 
   // Held-out data.
+  // Held-out samples whose position lies outside the fit part's position range are not scored
+  // (a candidate must not be credited or blamed for extrapolating the curve).
   HoldoutSplit split = HoldoutSplit::Interleaved;
   double holdout_fraction = 0.3;
-  int split_blocks = 10;
+  int split_blocks = 20;
 
   // Differentiators (Savitzky-Golay quadratic, centred), full window length in seconds.
   double velocity_window_s = 0.01;
@@ -63,8 +71,12 @@ struct AnalysisOptions {
   std::vector<std::string> candidates = named_effects();
   // Which added terms are attributed to the force sensor (subtracted from the reading to form the
   // clamp-force estimate) rather than to the true force. Maxwell-slip friction always is.
+  // temperature_drift: only its load-cell offset column; its curve gain/shift columns are true force.
   std::vector<std::string> sensor_effects = {"viscous_friction", "load_dependent_friction", "sensor_delay",
-                                             "temperature_drift", "creep"};
+                                             "temperature_drift"};
+  // Temperature at which the load cell reads no offset; NaN: the start of the recording (median
+  // of the first 100 samples), i.e. the load cell is taken as tared when the recording starts.
+  double temperature_reference_C = std::numeric_limits<double>::quiet_NaN();
 
   // Residual structure tests.
   int ljung_box_lags = 20;
