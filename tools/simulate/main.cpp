@@ -41,9 +41,9 @@ void plot_corner(const std::string& dir, const std::string& corner, const std::s
   gp += "set xlabel 'actuator position (rev)'\nset ylabel 'clamp force (kN)'\nset grid\n";
   gp += "set key top left\n";
   gp += "plot " + bbw::plot::quote(csv) +
-        " every 4::1 using 2:3 with lines lw 1 lc rgb '#1f77b4' title 'internal load cell', \\\n"
+        " every 8::1 using 2:3 with lines lw 1 lc rgb '#1f77b4' title 'internal load cell', \\\n"
         "     " + bbw::plot::quote(csv) +
-        " every 4::1 using 2:4 with lines lw 2 lc rgb '#d62728' title 'external sensor (true)'\n";
+        " every 8::1 using 2:4 with lines lw 2 lc rgb '#d62728' title 'external sensor (true)'\n";
   bbw::plot::run_gnuplot(gp, dir + "/" + corner + ".gp");
 }
 
