@@ -15,7 +15,8 @@ std::string usage() {
          "         [--temperature COL|none] [--velocity COL] [--acceleration COL]\n"
          "         [--channels A,B,...|none]\n"
          "defaults: time_s (or t_s), position_rev, force_internal_kN, truth force_external_kN and\n"
-         "temperature temperature_C when present; channels: every other column of the header.\n";
+         "temperature temperature_C and velocity speed_rev_s when present; channels: every other\n"
+         "column of the header except those whose name contains 'true' (simulator ground truth).\n";
 }
 
 namespace {
@@ -96,7 +97,7 @@ LoadedRecording load_recording(const CliArgs& a) {
   };
   L.truth_col = optional_default(a.truth_col, "force_external_kN");
   L.temperature_col = optional_default(a.temperature_col, "temperature_C");
-  L.velocity_col = optional_default(a.velocity_col, "");
+  L.velocity_col = optional_default(a.velocity_col, "speed_rev_s");
   L.acceleration_col = optional_default(a.acceleration_col, "");
 
   std::vector<std::string> used = {L.time_col, L.position_col, L.force_col, L.truth_col, L.temperature_col,
@@ -107,7 +108,7 @@ LoadedRecording load_recording(const CliArgs& a) {
       if (contains(used, ch)) throw std::invalid_argument("--channels: '" + ch + "' is already used as a model input");
   } else {
     for (const auto& h : header)
-      if (!contains(used, h)) L.channel_cols.push_back(h);
+      if (!contains(used, h) && h.find("true") == std::string::npos) L.channel_cols.push_back(h);
   }
 
   csv::ReadOptions o;
