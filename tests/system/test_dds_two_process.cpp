@@ -20,7 +20,7 @@ namespace {
 using namespace std::chrono_literals;
 
 TEST(DdsTwoProcess, EchoAnswersEveryBlockOfTheAddressedCorner) {
-  const std::string bin = std::string(std::getenv("BBW_BINARY_DIR")) + "/bin";
+  const std::string bin = std::string(BBW_TEST_BINARY_DIR) + "/bin";
   const auto logs = std::filesystem::temp_directory_path() / ("bbw_two_process_" + std::to_string(::getpid()));
   std::filesystem::create_directories(logs);
   constexpr int kBlocks = 300;

@@ -128,6 +128,10 @@ int main(int argc, char** argv) {
   }
 
   const std::string bin = bbw::launch::executable_dir();
+  // Test hook: BBW_LAUNCH_CORNER_BIN replaces the corner executable (e.g. one that fails to
+  // start), so the failure path is exercised with real processes.
+  const char* corner_bin_env = std::getenv("BBW_LAUNCH_CORNER_BIN");
+  const std::string corner_bin = corner_bin_env && *corner_bin_env ? corner_bin_env : bin + "/bbw_corner";
   const std::string dom = std::to_string(domain);
   const std::string disc = std::to_string(discovery_s);
   const auto wall0 = Clock::now();
@@ -140,7 +144,7 @@ int main(int argc, char** argv) {
     for (const auto& c : scenario->corners) {
       children.push_back(std::make_unique<Child>(
           "bbw_corner " + c.name,
-          std::vector<std::string>{bin + "/bbw_corner", "--corner", c.name, "--scenario", scenario_file, "--domain",
+          std::vector<std::string>{corner_bin, "--corner", c.name, "--scenario", scenario_file, "--domain",
                                    dom, "--mode", mode, "--stats", out_dir + "/corner_" + c.name + ".stats",
                                    "--discovery-timeout", disc},
           out_dir + "/corner_" + c.name + ".out", out_dir + "/corner_" + c.name + ".err"));
