@@ -663,7 +663,12 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
     st.parameters = effect_parameters(model_parameters(c, spec, cur), best->score.name);
     st.errors = cur.errors;
     if (res.steps.empty()) {
-      res.display_regressor_name = best->score.name;
+      const std::string& nm = best->score.name;
+      res.display_regressor_name = nm == "inertia"                                   ? "acceleration (" + nm + ")"
+                                   : nm == "viscous_friction" || nm == "sensor_delay" ? "velocity (" + nm + ")"
+                                   : nm == "temperature_drift"                        ? "temperature (" + nm + ")"
+                                   : nm == "backlash" ? "position - play(position) (backlash)"
+                                                      : "regressor of " + nm;
       res.display_regressor = display_signal(c, spec, best->score.name);
     }
     res.steps.push_back(st);

@@ -192,7 +192,7 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
   const std::string data = plot::quote(dir + "/plot_data.csv");
   if (plots) {
     std::ostringstream s;
-    s << "set terminal pngcairo size 1000,700\nset output " << plot::quote(dir + "/residual_time.png") << "\n"
+    s << "set terminal pngcairo size 1000,700 noenhanced\nset output " << plot::quote(dir + "/residual_time.png") << "\n"
       << "set datafile separator ','\nset key autotitle columnhead\nset multiplot layout 2,1\n"
       << "set xlabel 'time [s]'\nset ylabel 'residual [" << u << "]'\n"
       << "set title 'residual before (eq. 5 baseline)'\nplot " << data << " using 1:3 with dots lc rgb '#c03030' notitle\n"
@@ -200,7 +200,7 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
       << "unset multiplot\n";
     plot::run_gnuplot(s.str(), dir + "/residual_time.gp");
     std::ostringstream g;
-    g << "set terminal pngcairo size 1000,700\nset output " << plot::quote(dir + "/residual_vs_regressor.png") << "\n"
+    g << "set terminal pngcairo size 1000,700 noenhanced\nset output " << plot::quote(dir + "/residual_vs_regressor.png") << "\n"
       << "set datafile separator ','\nset multiplot layout 1,2\nset xlabel '" << r.display_regressor_name << "'\n"
       << "set ylabel 'residual [" << u << "]'\n"
       << "set title 'before'\nplot " << data << " using 2:3 with dots lc rgb '#c03030' notitle\n"
@@ -209,7 +209,7 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
     plot::run_gnuplot(g.str(), dir + "/residual_vs_regressor.gp");
     if (truth) {
       std::ostringstream t;
-      t << "set terminal pngcairo size 1000,500\nset output " << plot::quote(dir + "/truth_error_time.png") << "\n"
+      t << "set terminal pngcairo size 1000,500 noenhanced\nset output " << plot::quote(dir + "/truth_error_time.png") << "\n"
         << "set datafile separator ','\nset xlabel 'time [s]'\nset ylabel 'estimate - truth [" << u << "]'\n"
         << "plot " << data << " using 1:5 with lines lc rgb '#c03030' title 'before', " << data
         << " using 1:6 with lines lc rgb '#3030c0' title 'after'\n";
