@@ -1,5 +1,6 @@
 #include "ccu_app.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <stdexcept>
 
@@ -169,13 +170,31 @@ void CcuApp::process_block(const msg::MeasurementBlock& b) {
     ch->last_friction_kN = e.valid ? e.friction_kN : ch->last_friction_kN;
     const double fused = e.valid ? fuse(e, s.force_internal_kN(), options_.fusion_weight) : std::nan("");
     if (ch->csv != nullptr) {
-      std::fprintf(ch->csv,
-                   "%.17g,%llu,%llu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%d,%d\n",
-                   s.time_s(), static_cast<unsigned long long>(s.seq()),
-                   static_cast<unsigned long long>(b.block_seq()), s.position_rev(), s.speed_rev_s(),
-                   s.force_internal_kN(), s.force_external_kN(), s.force_true_kN(), s.temperature_C(),
-                   s.motor_current_A(), s.command(), (s.status() & msg::STATUS_FORCE_MODE) ? 1 : 0,
-                   e.force_kN, e.friction_kN, e.curve_force_kN, fused, e.valid ? 1 : 0, e.calibrated ? 1 : 0);
+      // Shortest round-trip decimal form (std::to_chars): exact, and far cheaper than %.17g.
+      char line[640];
+      char* p = line;
+      char* const last = line + sizeof(line);
+      auto put = [&](double v) {
+        p = std::to_chars(p, last, v).ptr;
+        *p++ = ',';
+      };
+      auto put_u = [&](unsigned long long v) {
+        p = std::to_chars(p, last, v).ptr;
+        *p++ = ',';
+      };
+      put(s.time_s());
+      put_u(s.seq());
+      put_u(b.block_seq());
+      for (double v : {s.position_rev(), s.speed_rev_s(), s.force_internal_kN(), s.force_external_kN(),
+                       s.force_true_kN(), s.temperature_C(), s.motor_current_A(), s.command()}) {
+        put(v);
+      }
+      put_u((s.status() & msg::STATUS_FORCE_MODE) ? 1 : 0);
+      for (double v : {e.force_kN, e.friction_kN, e.curve_force_kN, fused}) put(v);
+      put_u(e.valid ? 1 : 0);
+      put_u(e.calibrated ? 1 : 0);
+      p[-1] = '\n';
+      std::fwrite(line, 1, static_cast<std::size_t>(p - line), ch->csv);
     }
   }
   if (b.block_seq() + 1 >= periods_) ch->finished = true;

@@ -86,10 +86,9 @@ class CornerApp {
   dds::Participant participant_;
   dds::Writer<msg::MeasurementBlockPubSubType> blocks_;
   dds::Writer<msg::CornerHealthPubSubType> health_;
-  dds::ContentFilter command_filter_;
-  dds::ContentFilter calibration_filter_;
   dds::Reader<msg::ClampCommandPubSubType> commands_;
   dds::Reader<msg::CalibrationStatePubSubType> calibration_;
+  std::uint8_t my_id_;
 
   msg::MeasurementBlock block_;
   msg::ClampCommand latest_command_;
