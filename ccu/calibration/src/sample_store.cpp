@@ -43,21 +43,29 @@ void SampleStore::write(std::size_t phys, double x, double f, const double* n_ro
   if (n_row) std::copy(n_row, n_row + width_, n_.begin() + static_cast<std::ptrdiff_t>(phys * width_));
 }
 
+void SampleStore::rescan_settled_min() {
+  std::size_t j = 0;
+  const std::size_t n = capacity_ - 1;
+  for (std::size_t k = 1; k < n; ++k) {
+    if (d2_[k] < d2_[j]) j = k;
+  }
+  settled_min_ = j;
+}
+
 void SampleStore::add(double x_rev, double f_kN, const double* n_row) {
   if (count_ < capacity_) {
     write(order_[count_], x_rev, f_kN, n_row);
     if (count_ > 0) d2_[count_ - 1] = dist2(count_ - 1, count_);
     ++count_;
+    if (count_ == capacity_) rescan_settled_min();
     return;
   }
   // Store full: the new sample takes logical slot L (0-based), the spare one.
   const std::size_t L = capacity_;
   write(order_[L], x_rev, f_kN, n_row);
   d2_[L - 1] = dist2(L - 1, L);
-  std::size_t j = 0;
-  for (std::size_t k = 1; k < L; ++k) {
-    if (d2_[k] < d2_[j]) j = k;
-  }
+  // argmin over all L pairs, first index on ties: the new pair wins only if strictly smaller.
+  const std::size_t j = d2_[L - 1] < d2_[settled_min_] ? L - 1 : settled_min_;
   ++dropped_;
   if (j == L - 1) return;  // the new sample is closest to its predecessor: not recorded
   std::size_t drop = (rule_ == DropRule::DropJ) ? j : j + 1;
@@ -66,6 +74,7 @@ void SampleStore::add(double x_rev, double f_kN, const double* n_row) {
   order_[L] = freed;
   for (std::size_t k = drop; k + 1 < L; ++k) d2_[k] = d2_[k + 1];
   if (drop > 0) d2_[drop - 1] = dist2(drop - 1, drop);
+  rescan_settled_min();
 }
 
 double SampleStore::min_x_rev() const {

@@ -50,6 +50,12 @@ class SampleStore {
   std::vector<double> d2_;            // d2_[k]: squared distance between logical k and k + 1
   std::size_t count_ = 0;
   std::uint64_t dropped_ = 0;
+  // Index of the smallest of d2_[0 .. L-2] (the pairs that stay when a new sample is dropped),
+  // kept up to date so that the common case, a new sample closest to its predecessor, costs
+  // O(1); a drop of an older sample rescans (the paper notes the minimum can be kept
+  // incrementally).
+  std::size_t settled_min_ = 0;
+  void rescan_settled_min();
 };
 
 }  // namespace bbw::calibration

@@ -1,0 +1,106 @@
+// Calibrator speed and memory at the paper's size (M = 8, L = 64, N = 20).
+//   ./bbw bench Calibrator      (or build/bin/bench_calibrator)
+// The recording is the paper rig at 44 C from the plant (config/scenarios/paper_rig_44C.yaml).
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "bbw/calibration/config_yaml.hpp"
+#include "bbw/calibration/offline.hpp"
+#include "bbw/scenario/corner_sim.hpp"
+#include "bbw/scenario/load.hpp"
+
+using namespace bbw::calibration;
+
+namespace {
+
+const Recording& recording() {
+  static const Recording rec = [] {
+    const auto sc = bbw::scenario::load_scenario(std::string(BBW_SOURCE_DIR) + "/config/scenarios/paper_rig_44C.yaml");
+    bbw::scenario::CornerSim sim(sc, 0);
+    Recording r;
+    const auto steps = static_cast<std::size_t>(std::llround(sc.duration_s / sc.plant_dt_s));
+    for (std::size_t k = 0; k < steps; ++k) {
+      const auto& s = sim.step(sc.plant_dt_s);
+      r.time_s.push_back(s.time_s);
+      r.position_rev.push_back(s.position_rev);
+      r.force_kN.push_back(s.force_internal_kN);
+      r.truth_kN.push_back(s.force_external_kN);
+    }
+    return r;
+  }();
+  return rec;
+}
+
+CalibratorConfig config(Mode mode) {
+  auto c = load_config(std::string(BBW_SOURCE_DIR) + "/config/calibrator/robust.yaml");
+  c.mode = mode;
+  c.elements_M = 8;
+  c.samples_L = 64;
+  c.pf_points_N = 20;
+  return c;
+}
+
+// Per-sample cost including the amortised cycle-end fits: one iteration = one sample; the
+// recording is replayed in a loop (time shifted so it keeps increasing).
+void BM_CalibratorUpdate(benchmark::State& state) {
+  const auto& rec = recording();
+  const Mode mode = state.range(0) == 0 ? Mode::Robust : Mode::Paper;
+  Calibrator cal(config(mode));
+  std::size_t k = 0;
+  double t_offset = 0.0;
+  const double span = rec.time_s.back() + 0.001;
+  for (auto _ : state) {
+    auto e = cal.update({rec.time_s[k] + t_offset, rec.position_rev[k], rec.force_kN[k]});
+    benchmark::DoNotOptimize(e);
+    if (++k == rec.time_s.size()) {
+      k = 0;
+      t_offset += span;
+    }
+  }
+  state.counters["fits"] = static_cast<double>(cal.stats().fits_accepted + cal.stats().fits_rejected);
+  state.counters["state_bytes"] = static_cast<double>(cal.state_bytes());
+  state.SetLabel(to_string(mode));
+}
+BENCHMARK(BM_CalibratorUpdate)->Arg(0)->Arg(1);
+
+// Cost of the one update() that ends a cycle (the fit, PF update and global refit): the
+// samples of each cycle are fed with the timer paused, the cycle-ending sample is timed.
+void BM_CycleEndFit(benchmark::State& state) {
+  const auto& rec = recording();
+  const Mode mode = state.range(0) == 0 ? Mode::Robust : Mode::Paper;
+  Calibrator cal(config(mode));
+  // Find the indices where cycles start in this recording (same for every replay).
+  std::vector<std::size_t> starts;
+  {
+    Calibrator probe(config(mode));
+    for (std::size_t k = 0; k < rec.time_s.size(); ++k) {
+      if (probe.update({rec.time_s[k], rec.position_rev[k], rec.force_kN[k]}).cycle_start) starts.push_back(k);
+    }
+  }
+  std::size_t k = 0, next = 1;
+  double t_offset = 0.0;
+  const double span = rec.time_s.back() + 0.001;
+  std::uint64_t fits_before = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    if (next >= starts.size()) {  // replay from the beginning with a fresh calibrator state
+      cal = Calibrator(config(mode));
+      k = 0;
+      next = 1;
+      t_offset += span;
+    }
+    for (; k < starts[next]; ++k) cal.update({rec.time_s[k] + t_offset, rec.position_rev[k], rec.force_kN[k]});
+    fits_before = cal.stats().fits_accepted + cal.stats().fits_rejected;
+    state.ResumeTiming();
+    auto e = cal.update({rec.time_s[k] + t_offset, rec.position_rev[k], rec.force_kN[k]});
+    benchmark::DoNotOptimize(e);
+    ++k;
+    ++next;
+  }
+  state.counters["fit_ran"] = static_cast<double>(cal.stats().fits_accepted + cal.stats().fits_rejected - fits_before);
+  state.SetLabel(to_string(mode));
+}
+BENCHMARK(BM_CycleEndFit)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
