@@ -32,6 +32,7 @@ inline Recording record_corner(const bbw::scenario::Scenario& sc, std::size_t in
     rec.position_rev.push_back(s.position_rev);
     rec.force_kN.push_back(s.force_internal_kN);
     rec.truth_kN.push_back(s.force_external_kN);
+    rec.speed_rev_s.push_back(s.speed_rev_s);
   }
   return rec;
 }

@@ -16,15 +16,15 @@ namespace {
 
 const char* kUsage =
     "usage: bbw_calibrate --input FILE.csv [--config FILE.yaml] --out DIR\n"
-    "                     [--time COL] [--position COL] [--force COL] [--truth COL]\n"
+    "                     [--time COL] [--position COL] [--force COL] [--truth COL] [--speed COL]\n"
     "  Runs the calibrator over a recording. Default columns: time_s, position_rev,\n"
-    "  force_internal_kN; truth: force_external_kN when present.\n";
+    "  force_internal_kN; truth: force_external_kN and speed: speed_rev_s when present.\n";
 
 struct Args {
   std::string input, config = BBW_DEFAULT_CALIBRATOR_CONFIG, out;
   std::string time_col = "time_s", position_col = "position_rev", force_col = "force_internal_kN";
-  std::string truth_col;
-  bool truth_given = false;
+  std::string truth_col, speed_col;
+  bool truth_given = false, speed_given = false;
 };
 
 bool parse(int argc, char** argv, Args& a) {
@@ -41,6 +41,7 @@ bool parse(int argc, char** argv, Args& a) {
     else if (k == "--position") next(a.position_col);
     else if (k == "--force") next(a.force_col);
     else if (k == "--truth") { next(a.truth_col); a.truth_given = true; }
+    else if (k == "--speed") { next(a.speed_col); a.speed_given = true; }
     else if (k == "-h" || k == "--help") { std::cout << kUsage; std::exit(0); }
     else throw std::invalid_argument("unknown argument '" + k + "'");
   }
@@ -87,7 +88,9 @@ int main(int argc, char** argv) {
     bbw::csv::ReadOptions ro;
     ro.required = {a.time_col, a.position_col, a.force_col};
     if (a.truth_given) ro.required.push_back(a.truth_col);
-    else ro.optional = {"force_external_kN"};
+    else ro.optional.push_back("force_external_kN");
+    if (a.speed_given) ro.required.push_back(a.speed_col);
+    else ro.optional.push_back("speed_rev_s");
     const auto table = bbw::csv::read(a.input, ro);
     if (table.lines_rejected > 0) std::cerr << "bbw_calibrate: " << a.input << ": " << table.rejection_summary() << "\n";
     const std::string truth_col = a.truth_given ? a.truth_col : (table.has("force_external_kN") ? "force_external_kN" : "");
@@ -97,6 +100,8 @@ int main(int argc, char** argv) {
     rec.position_rev = table.column(a.position_col);
     rec.force_kN = table.column(a.force_col);
     if (!truth_col.empty()) rec.truth_kN = table.column(truth_col);
+    const std::string speed_col = a.speed_given ? a.speed_col : (table.has("speed_rev_s") ? "speed_rev_s" : "");
+    if (!speed_col.empty()) rec.speed_rev_s = table.column(speed_col);
     const auto res = bbw::calibration::run_recording(config, rec);
 
     ::mkdir(a.out.c_str(), 0755);
@@ -151,6 +156,8 @@ int main(int argc, char** argv) {
     j.begin_object("friction")
         .numbers("delta_rev", res.friction.delta_rev)
         .numbers("stiffness_kN_per_rev", res.friction.stiffness_kN_per_rev)
+        .value("viscous_enabled", config.viscous_friction)
+        .value("viscous_kN_per_rev_per_s", res.friction.viscous_kN_per_rev_per_s)
         .end_object();
     j.end_object();
     j.save(a.out + "/summary.json");

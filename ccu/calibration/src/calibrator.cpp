@@ -87,21 +87,22 @@ Calibrator::Calibrator(const CalibratorConfig& config)
       scaled_(robust_ && config.scale_x),
       nonneg_(robust_ && config.nonnegative_k),
       m_(config.elements_M),
-      p_(kCurveTerms + config.elements_M),
+      e_(config.viscous_friction ? 1 : 0),
+      p_(kCurveTerms + config.elements_M + (config.viscous_friction ? 1 : 0)),
       xc_rev_(0.5 * (config.x_max_rev + config.x_min_rev)),
       xh_rev_(0.5 * (config.x_max_rev - config.x_min_rev)),
       curve_(config.initial_curve),
       detector_(config.start_lag_n0, robust_ ? config.start_margin_rev : 0.0),
-      store_(config.samples_L, config.elements_M, config.x_max_rev - config.x_min_rev,
+      store_(config.samples_L, config.elements_M + (config.viscous_friction ? 1 : 0), config.x_max_rev - config.x_min_rev,
              config.f_max_kN - config.f_min_kN, config.drop_rule),
-      solver_(kCurveTerms + config.elements_M) {
+      solver_(kCurveTerms + config.elements_M + (config.viscous_friction ? 1 : 0)) {
   const auto m = static_cast<std::size_t>(m_);
   const auto p = static_cast<std::size_t>(p_);
   friction_.delta_rev.assign(m, 0.0);
   const bool geometric = robust_ && config.spacing == ThresholdSpacing::Geometric;
   thresholds(m, config.delta_max_rev, geometric, config.geometric_ratio, friction_.delta_rev.data());
   friction_.stiffness_kN_per_rev.assign(m, 0.0);
-  phi_kN_.assign(m, 0.0);
+  phi_kN_.assign(m + static_cast<std::size_t>(e_), 0.0);
 
   const auto n_pf = static_cast<std::size_t>(config.pf_points_N) + 1;
   pf_x_rev_.resize(n_pf);
@@ -114,13 +115,17 @@ Calibrator::Calibrator(const CalibratorConfig& config)
   for (std::size_t k = 0; k < n_pf; ++k) pf_f_kN_[k] = curve_.force_kN(pf_x_rev_[k]);
 
   element_pos_rev_.assign(m, 0.0);
-  n_now_.assign(m, 0.0);
+  n_now_.assign(m + static_cast<std::size_t>(e_), 0.0);
+  if (e_ > 0) {
+    vel_t_s_.assign(static_cast<std::size_t>(config.velocity_window), 0.0);
+    vel_x_rev_.assign(static_cast<std::size_t>(config.velocity_window), 0.0);
+  }
   start_pos_rev_.assign(m, 0.0);
   gram_.assign(p * p, 0.0);
   rhs_.assign(p, 0.0);
   theta_.assign(p, 0.0);
   row_.assign(p, 0.0);
-  n_replay_.assign(m, 0.0);
+  n_replay_.assign(m + static_cast<std::size_t>(e_), 0.0);
   pos_replay_.assign(m, 0.0);
   column_on_.assign(p, 1);
   column_map_.assign(p, 0);
@@ -131,7 +136,7 @@ std::size_t Calibrator::state_bytes() const {
   auto vb = [](const auto& v) { return v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type); };
   return sizeof(*this) + vb(friction_.delta_rev) + vb(friction_.stiffness_kN_per_rev) + vb(phi_kN_) +
          vb(pf_x_rev_) + vb(pf_f_kN_) + vb(pf_proj_) + (store_.bytes() - sizeof(store_)) +
-         (solver_.bytes() - sizeof(solver_)) + vb(element_pos_rev_) + vb(n_now_) + vb(start_pos_rev_) +
+         (solver_.bytes() - sizeof(solver_)) + vb(element_pos_rev_) + vb(n_now_) + vb(vel_t_s_) + vb(vel_x_rev_) + vb(start_pos_rev_) +
          vb(gram_) + vb(rhs_) + vb(theta_) + vb(row_) + vb(n_replay_) + vb(pos_replay_) + vb(column_on_) +
          vb(column_map_) + vb(nonneg_flags_) + static_cast<std::size_t>(2 * config_.start_lag_n0 + 1) * sizeof(double);
 }
@@ -142,11 +147,11 @@ void Calibrator::reset_curve(const Curve& curve) {
 }
 
 void Calibrator::set_friction_stiffness(const std::vector<double>& k_kN_per_rev) {
-  if (k_kN_per_rev.size() != phi_kN_.size()) {
-    throw std::invalid_argument("set_friction_stiffness: expected " + std::to_string(phi_kN_.size()) +
+  if (k_kN_per_rev.size() != friction_.delta_rev.size()) {
+    throw std::invalid_argument("set_friction_stiffness: expected " + std::to_string(friction_.delta_rev.size()) +
                                 " stiffnesses, got " + std::to_string(k_kN_per_rev.size()));
   }
-  for (std::size_t i = 0; i < phi_kN_.size(); ++i) {
+  for (std::size_t i = 0; i < k_kN_per_rev.size(); ++i) {
     friction_.stiffness_kN_per_rev[i] = k_kN_per_rev[i];
     phi_kN_[i] = k_kN_per_rev[i] * friction_.delta_rev[i];
   }
@@ -171,6 +176,7 @@ void Calibrator::regressor_row(double x_rev, const double* n, double* row) const
   for (int i = 0; i < m_; ++i) {
     row[kCurveTerms + i] = robust_ ? n[i] : friction_.delta_rev[static_cast<std::size_t>(i)] * n[i];
   }
+  for (int i = 0; i < e_; ++i) row[kCurveTerms + m_ + i] = n[m_ + i];
 }
 
 void Calibrator::start_cycle(double x_rev) {
@@ -198,13 +204,13 @@ bool Calibrator::end_cycle() {
   int p_on = 0;
   for (int j = 0; j < p_; ++j) {
     bool on = true;
-    if (j >= kCurveTerms && robust_ && config_.identify_per_element) {
+    if (j >= kCurveTerms && j < kCurveTerms + m_ && robust_ && config_.identify_per_element) {
       on = span >= 2.0 * friction_.delta_rev[static_cast<std::size_t>(j - kCurveTerms)];
     }
     column_on_[static_cast<std::size_t>(j)] = on ? 1 : 0;
     if (on) {
       column_map_[static_cast<std::size_t>(p_on)] = j;
-      nonneg_flags_[static_cast<std::size_t>(p_on)] = (nonneg_ && j >= kCurveTerms) ? 1 : 0;
+      nonneg_flags_[static_cast<std::size_t>(p_on)] = ((nonneg_ || j >= kCurveTerms + m_) && j >= kCurveTerms) ? 1 : 0;
       ++p_on;
     }
   }
@@ -222,9 +228,10 @@ bool Calibrator::end_cycle() {
       // The paper's flowchart: replay the elements from x0_i over the stored samples.
       elements_step(x, friction_.delta_rev.data(), pos_replay_.data(), static_cast<std::size_t>(m_), nullptr,
                     n_replay_.data());
+      for (int i = 0; i < e_; ++i) n_replay_[static_cast<std::size_t>(m_ + i)] = n[m_ + i];
       n = n_replay_.data();
     }
-    double full[64 + kCurveTerms];
+    double full[64 + kCurveTerms + 1];
     regressor_row(x, n, full);
     double b = store_.f_kN(r);
     if (robust_) {
@@ -265,9 +272,10 @@ bool Calibrator::end_cycle() {
     if (!streaming_) {
       elements_step(x, friction_.delta_rev.data(), pos_replay_.data(), static_cast<std::size_t>(m_), nullptr,
                     n_replay_.data());
+      for (int i = 0; i < e_; ++i) n_replay_[static_cast<std::size_t>(m_ + i)] = n[m_ + i];
       n = n_replay_.data();
     }
-    double full[64 + kCurveTerms];
+    double full[64 + kCurveTerms + 1];
     regressor_row(x, n, full);
     double model = 0.0;
     for (std::size_t a = 0; a < pu; ++a) model += full[column_map_[a]] * theta_[a];
@@ -304,10 +312,12 @@ bool Calibrator::end_cycle() {
   // Friction amplitudes.
   for (std::size_t a = kCurveTerms; a < pu; ++a) {
     const auto i = static_cast<std::size_t>(column_map_[a] - kCurveTerms);
-    const double phi_new = robust_ ? theta_[a] : theta_[a] * friction_.delta_rev[i];
+    const bool element = i < static_cast<std::size_t>(m_);
+    const double phi_new = (robust_ || !element) ? theta_[a] : theta_[a] * friction_.delta_rev[i];
     const double w = (robust_ && stats_.fits_accepted > 0) ? config_.k_smoothing : 1.0;
     phi_kN_[i] = (1.0 - w) * phi_kN_[i] + w * phi_new;
-    friction_.stiffness_kN_per_rev[i] = phi_kN_[i] / friction_.delta_rev[i];
+    if (element) friction_.stiffness_kN_per_rev[i] = phi_kN_[i] / friction_.delta_rev[i];
+    else friction_.viscous_kN_per_rev_per_s = phi_kN_[i] / config_.viscous_speed_scale_rev_per_s;
   }
   return true;
 }
@@ -321,6 +331,33 @@ void Calibrator::refit_curve_from_pf() {
     c[r] = s;
   }
   curve_ = raw_from_scaled(c, xc_rev_, xh_rev_);
+}
+
+// Resolver speed when the sample carries one; else the least-squares slope of the last
+// velocity_window positions (causal: it lags by about half the window).
+double Calibrator::speed_now(const Sample& s) {
+  const std::size_t w = vel_t_s_.size();
+  vel_head_ = (vel_head_ + 1) % w;
+  vel_t_s_[vel_head_] = s.time_s;
+  vel_x_rev_[vel_head_] = s.position_rev;
+  if (vel_count_ < w) ++vel_count_;
+  if (std::isfinite(s.speed_rev_s)) return s.speed_rev_s;
+  if (vel_count_ < 2) return 0.0;
+  double tm = 0.0, xm = 0.0;
+  for (std::size_t k = 0; k < vel_count_; ++k) {
+    const std::size_t i = (vel_head_ + w - k) % w;
+    tm += vel_t_s_[i];
+    xm += vel_x_rev_[i];
+  }
+  tm /= static_cast<double>(vel_count_);
+  xm /= static_cast<double>(vel_count_);
+  double num = 0.0, den = 0.0;
+  for (std::size_t k = 0; k < vel_count_; ++k) {
+    const std::size_t i = (vel_head_ + w - k) % w;
+    num += (vel_t_s_[i] - tm) * (vel_x_rev_[i] - xm);
+    den += (vel_t_s_[i] - tm) * (vel_t_s_[i] - tm);
+  }
+  return den > 0.0 ? num / den : 0.0;
 }
 
 Estimate Calibrator::update(const Sample& s) {
@@ -365,8 +402,9 @@ Estimate Calibrator::update(const Sample& s) {
   const double friction = elements_step(x, friction_.delta_rev.data(), element_pos_rev_.data(),
                                         static_cast<std::size_t>(m_), nullptr, n_now_.data());
   (void)friction;
+  if (e_ > 0) n_now_[static_cast<std::size_t>(m_)] = speed_now(s) / config_.viscous_speed_scale_rev_per_s;
   double f_fric = 0.0;
-  for (int i = 0; i < m_; ++i) f_fric += phi_kN_[static_cast<std::size_t>(i)] * n_now_[static_cast<std::size_t>(i)];
+  for (int i = 0; i < m_ + e_; ++i) f_fric += phi_kN_[static_cast<std::size_t>(i)] * n_now_[static_cast<std::size_t>(i)];
 
   if (in_cycle_) {
     store_.add(x, s.force_kN, n_now_.data());

@@ -42,6 +42,8 @@ void CalibratorConfig::validate() const {
   if (!(ridge >= 0.0)) bad("ridge", ridge, "must be >= 0");
   if (!(max_fit_rms_kN > 0.0)) bad("max_fit_rms_kN", max_fit_rms_kN, "must be > 0");
   if (!(start_margin_rev >= 0.0)) bad("start_margin_rev", start_margin_rev, "must be >= 0");
+  if (!(viscous_speed_scale_rev_per_s > 0.0)) bad("viscous_speed_scale_rev_per_s", viscous_speed_scale_rev_per_s, "must be > 0");
+  if (velocity_window < 2 || velocity_window > 1000) bad("velocity_window", velocity_window, "must be in [2, 1000]");
   if (!(k_smoothing > 0.0 && k_smoothing <= 1.0)) bad("k_smoothing", k_smoothing, "must be in (0, 1]");
 }
 

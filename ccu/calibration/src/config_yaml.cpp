@@ -60,6 +60,13 @@ CalibratorConfig read_config(Reader& r) {
     c.identify_per_element = rb->boolean_or("identify_per_element", c.identify_per_element);
     rb->finish();
   }
+  if (auto fx = r.optional_map("effects")) {
+    c.viscous_friction = fx->boolean_or("viscous_friction", c.viscous_friction);
+    c.viscous_speed_scale_rev_per_s =
+        fx->number_or("viscous_speed_scale_rev_per_s", c.viscous_speed_scale_rev_per_s, Range::positive());
+    c.velocity_window = static_cast<int>(fx->integer_or("velocity_window", c.velocity_window, 2, 1000));
+    fx->finish();
+  }
   try {
     c.validate();
   } catch (const std::invalid_argument& e) {

@@ -31,7 +31,9 @@ OfflineResult run_recording(const CalibratorConfig& config, const Recording& rec
   OfflineResult out;
   out.estimates.reserve(rec.time_s.size());
   for (std::size_t k = 0; k < rec.time_s.size(); ++k) {
-    out.estimates.push_back(cal.update({rec.time_s[k], rec.position_rev[k], rec.force_kN[k]}));
+    Sample s{rec.time_s[k], rec.position_rev[k], rec.force_kN[k]};
+    if (!rec.speed_rev_s.empty()) s.speed_rev_s = rec.speed_rev_s[k];
+    out.estimates.push_back(cal.update(s));
   }
   out.stats = cal.stats();
   out.curve = cal.curve();

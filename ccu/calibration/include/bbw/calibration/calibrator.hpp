@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "bbw/calibration/bounded_lsq.hpp"
@@ -19,11 +20,12 @@ struct Sample {
   double time_s = 0.0;
   double position_rev = 0.0;  // resolver position, actuator revolutions
   double force_kN = 0.0;      // internal load-cell reading (true force + key friction)
+  double speed_rev_s = std::numeric_limits<double>::quiet_NaN();  // resolver speed; NaN = not given
 };
 
 struct Estimate {
   double force_kN = 0.0;        // f_hat = load cell minus estimated friction
-  double friction_kN = 0.0;     // estimated key/keyway friction sum K_i Delta_i n_i
+  double friction_kN = 0.0;     // estimated key/keyway friction sum K_i Delta_i n_i (+ c_v v when enabled)
   double curve_force_kN = 0.0;  // A x^3 + B x^2 + C x + D at the sample's position
   bool valid = false;           // false when the sample was rejected (NaN, out of range, time backwards)
   bool calibrated = false;      // true once at least one cycle fit was accepted
@@ -46,6 +48,7 @@ struct Stats {
 struct FrictionParams {
   std::vector<double> delta_rev;
   std::vector<double> stiffness_kN_per_rev;
+  double viscous_kN_per_rev_per_s = 0.0;  // c_v, when the viscous term is enabled
 };
 
 class Calibrator {
@@ -84,7 +87,8 @@ class Calibrator {
   bool scaled_;
   bool nonneg_;
   int m_;      // elements
-  int p_;      // parameters per fit: 4 + M
+  int e_;      // extra effect terms (0 or 1: viscous)
+  int p_;      // parameters per fit: 4 + M + E
   double xc_rev_, xh_rev_;  // scaling x_s = (x - xc) / xh
 
   Curve curve_;
@@ -107,7 +111,10 @@ class Calibrator {
   bool states_known_ = false;
 
   std::vector<double> element_pos_rev_;  // live element positions x_i
-  std::vector<double> n_now_;            // live n_i
+  std::vector<double> n_now_;            // live n_i, then the extra regressors
+  std::vector<double> vel_t_s_, vel_x_rev_;  // ring of recent samples for the speed fallback
+  std::size_t vel_head_ = 0, vel_count_ = 0;
+  double speed_now(const Sample& s);
   std::vector<double> start_pos_rev_;    // x0_i at the current cycle's start (replay)
 
   // Fit workspace, sized at construction.

@@ -50,6 +50,13 @@ struct CalibratorConfig {
   double k_smoothing = 1.0;          // weight of a new fit's friction stiffness (1 = replace)
   bool identify_per_element = true;  // update K_i only when the cycle span >= 2 Delta_i
 
+  // Optional model terms for effects found offline (./bbw analyze), per caliper.
+  // viscous_friction: a load-cell term c_v * v (v = resolver speed, or the slope of the last
+  // velocity_window positions when the sample carries no speed), fitted with K_i, c_v >= 0.
+  bool viscous_friction = false;
+  double viscous_speed_scale_rev_per_s = 10.0;  // regressor scaling inside the fit
+  int velocity_window = 9;                      // samples, for the position-slope fallback
+
   // Throws std::invalid_argument naming the field, its value and the rule.
   void validate() const;
 };
