@@ -1,0 +1,114 @@
+// The calibrator's YAML loader: every shipped file loads; each kind of mistake is reported
+// with file, line, key path and rule.
+#include <gtest/gtest.h>
+
+#include <dirent.h>
+
+#include <fstream>
+#include <string>
+
+#include "bbw/calibration/config_yaml.hpp"
+
+using bbw::calibration::load_config;
+using bbw::config::ConfigError;
+
+namespace {
+
+std::string source_dir() {
+  const char* root = std::getenv("BBW_SOURCE_DIR");
+  return root ? root : BBW_SOURCE_DIR_FALLBACK;
+}
+
+std::string robust_text() {
+  std::ifstream f(source_dir() + "/config/calibrator/robust.yaml");
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+ConfigError load_broken(const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/broken_calibrator.yaml";
+  {
+    std::ofstream f(path);
+    f << text;
+  }
+  try {
+    load_config(path);
+  } catch (const ConfigError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "expected a ConfigError for:\n" << text;
+  return ConfigError("", 0, "", "");
+}
+
+std::string replace(std::string s, const std::string& from, const std::string& to) {
+  const auto pos = s.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  if (pos != std::string::npos) s.replace(pos, from.size(), to);
+  return s;
+}
+
+int line_of(const std::string& text, const std::string& needle) {
+  const auto pos = text.find(needle);
+  int line = 1;
+  for (std::size_t i = 0; i < pos; ++i) line += text[i] == '\n';
+  return line;
+}
+
+}  // namespace
+
+TEST(CalibratorConfigYaml, EveryShippedFileLoads) {
+  const std::string dir = source_dir() + "/config/calibrator";
+  DIR* d = opendir(dir.c_str());
+  ASSERT_NE(d, nullptr) << dir;
+  int loaded = 0;
+  while (dirent* e = readdir(d)) {
+    const std::string name = e->d_name;
+    if (name.size() < 5 || name.substr(name.size() - 5) != ".yaml") continue;
+    EXPECT_NO_THROW(load_config(dir + "/" + name)) << name;
+    ++loaded;
+  }
+  closedir(d);
+  EXPECT_GE(loaded, 2);
+  EXPECT_EQ(load_config(dir + "/paper.yaml").mode, bbw::calibration::Mode::Paper);
+  EXPECT_EQ(load_config(dir + "/robust.yaml").mode, bbw::calibration::Mode::Robust);
+}
+
+TEST(CalibratorConfigYaml, UnknownKey) {
+  const auto text = replace(robust_text(), "  scale_x: true", "  scale_x: true\n  scale_y: true");
+  const auto e = load_broken(text);
+  EXPECT_EQ(e.key_path(), "robust.scale_y");
+  EXPECT_EQ(e.rule(), "unknown key");
+  EXPECT_EQ(e.line(), line_of(text, "scale_y"));
+}
+
+TEST(CalibratorConfigYaml, MissingKey) {
+  const auto e = load_broken(replace(robust_text(), "samples_L: 64\n", ""));
+  EXPECT_EQ(e.key_path(), "samples_L");
+  EXPECT_EQ(e.rule(), "required key is missing");
+}
+
+TEST(CalibratorConfigYaml, WrongType) {
+  const auto text = replace(robust_text(), "delta_max_rev: 0.4", "delta_max_rev: wide");
+  const auto e = load_broken(text);
+  EXPECT_EQ(e.key_path(), "delta_max_rev");
+  EXPECT_EQ(e.line(), line_of(text, "delta_max_rev"));
+  EXPECT_NE(e.rule().find("must be a number"), std::string::npos);
+}
+
+TEST(CalibratorConfigYaml, OutOfRange) {
+  auto e = load_broken(replace(robust_text(), "elements_M: 8", "elements_M: 0"));
+  EXPECT_EQ(e.key_path(), "elements_M");
+  EXPECT_EQ(e.rule(), "must be an integer in [1, 64], got 0");
+  e = load_broken(replace(robust_text(), "  geometric_ratio: 0.6", "  geometric_ratio: 1.5"));
+  EXPECT_EQ(e.key_path(), "robust.geometric_ratio");
+  e = load_broken(replace(robust_text(), "x_max_rev: 6.0", "x_max_rev: 0.5"));
+  EXPECT_EQ(e.key_path(), "range.x_max_rev");
+  EXPECT_EQ(e.rule(), "must be > range.x_min_rev");
+  e = load_broken(replace(robust_text(), "mode: robust", "mode: magic"));
+  EXPECT_EQ(e.rule(), "must be one of {paper, robust}, got 'magic'");
+}
+
+TEST(CalibratorConfigYaml, CrossFieldRuleNamesTheField) {
+  // samples_L must leave room for 2 (4 + M) rows: a rule between two fields.
+  const auto e = load_broken(replace(robust_text(), "samples_L: 64", "samples_L: 10"));
+  EXPECT_NE(e.rule().find("samples_L = 10"), std::string::npos) << e.what();
+}
