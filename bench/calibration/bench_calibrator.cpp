@@ -7,7 +7,7 @@
 
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/calibration/offline.hpp"
-#include "bbw/scenario/corner_sim.hpp"
+#include "bbw/calibration/rig_recording.hpp"
 #include "bbw/scenario/load.hpp"
 
 using namespace bbw::calibration;
@@ -15,20 +15,8 @@ using namespace bbw::calibration;
 namespace {
 
 const Recording& recording() {
-  static const Recording rec = [] {
-    const auto sc = bbw::scenario::load_scenario(std::string(BBW_SOURCE_DIR) + "/config/scenarios/paper_rig_44C.yaml");
-    bbw::scenario::CornerSim sim(sc, 0);
-    Recording r;
-    const auto steps = static_cast<std::size_t>(std::llround(sc.duration_s / sc.plant_dt_s));
-    for (std::size_t k = 0; k < steps; ++k) {
-      const auto& s = sim.step(sc.plant_dt_s);
-      r.time_s.push_back(s.time_s);
-      r.position_rev.push_back(s.position_rev);
-      r.force_kN.push_back(s.force_internal_kN);
-      r.truth_kN.push_back(s.force_external_kN);
-    }
-    return r;
-  }();
+  static const Recording rec = record_corner(
+      bbw::scenario::load_scenario(std::string(BBW_SOURCE_DIR) + "/config/scenarios/paper_rig_44C.yaml"), 0);
   return rec;
 }
 

@@ -1,5 +1,4 @@
-// Records one corner of a scenario with the plant (no DDS): the same CornerSim the corner
-// process runs. Test helper shared by the calibrator's accuracy tests.
+// Test helpers shared by the calibrator's accuracy tests.
 #pragma once
 
 #include <cmath>
@@ -7,8 +6,8 @@
 #include <string>
 
 #include "bbw/calibration/offline.hpp"
+#include "bbw/calibration/rig_recording.hpp"
 #include "bbw/plant/clamp_curve.hpp"
-#include "bbw/scenario/corner_sim.hpp"
 #include "bbw/scenario/load.hpp"
 
 namespace bbw::calibration::test {
@@ -16,25 +15,6 @@ namespace bbw::calibration::test {
 inline std::string source_path(const std::string& rel) {
   const char* root = std::getenv("BBW_SOURCE_DIR");
   return std::string(root ? root : BBW_SOURCE_DIR_FALLBACK) + "/" + rel;
-}
-
-inline Recording record_corner(const bbw::scenario::Scenario& sc, std::size_t index) {
-  bbw::scenario::CornerSim sim(sc, index);
-  Recording rec;
-  const auto steps = static_cast<std::size_t>(std::llround(sc.duration_s / sc.plant_dt_s));
-  rec.time_s.reserve(steps);
-  rec.position_rev.reserve(steps);
-  rec.force_kN.reserve(steps);
-  rec.truth_kN.reserve(steps);
-  for (std::size_t k = 0; k < steps; ++k) {
-    const auto& s = sim.step(sc.plant_dt_s);
-    rec.time_s.push_back(s.time_s);
-    rec.position_rev.push_back(s.position_rev);
-    rec.force_kN.push_back(s.force_internal_kN);
-    rec.truth_kN.push_back(s.force_external_kN);
-    rec.speed_rev_s.push_back(s.speed_rev_s);
-  }
-  return rec;
 }
 
 // Least-squares cubic through the plant's true curve over [x0, x1] at a temperature.

@@ -10,7 +10,6 @@
 #include "rig_recording.hpp"
 
 using namespace bbw::calibration;
-using bbw::calibration::test::record_corner;
 using bbw::calibration::test::source_path;
 
 namespace {

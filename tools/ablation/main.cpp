@@ -11,7 +11,7 @@
 
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/calibration/offline.hpp"
-#include "bbw/scenario/corner_sim.hpp"
+#include "bbw/calibration/rig_recording.hpp"
 #include "bbw/scenario/load.hpp"
 
 using namespace bbw::calibration;
@@ -25,19 +25,7 @@ struct Variant {
 
 std::vector<Recording> record_all(const bbw::scenario::Scenario& sc) {
   std::vector<Recording> out;
-  for (std::size_t i = 0; i < sc.corners.size(); ++i) {
-    bbw::scenario::CornerSim sim(sc, i);
-    Recording r;
-    const auto steps = static_cast<std::size_t>(std::llround(sc.duration_s / sc.plant_dt_s));
-    for (std::size_t k = 0; k < steps; ++k) {
-      const auto& s = sim.step(sc.plant_dt_s);
-      r.time_s.push_back(s.time_s);
-      r.position_rev.push_back(s.position_rev);
-      r.force_kN.push_back(s.force_internal_kN);
-      r.truth_kN.push_back(s.force_external_kN);
-    }
-    out.push_back(std::move(r));
-  }
+  for (std::size_t i = 0; i < sc.corners.size(); ++i) out.push_back(record_corner(sc, i));
   return out;
 }
 

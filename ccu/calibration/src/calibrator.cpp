@@ -125,6 +125,7 @@ Calibrator::Calibrator(const CalibratorConfig& config)
   rhs_.assign(p, 0.0);
   theta_.assign(p, 0.0);
   row_.assign(p, 0.0);
+  full_row_.assign(p, 0.0);
   n_replay_.assign(m + static_cast<std::size_t>(e_), 0.0);
   pos_replay_.assign(m, 0.0);
   column_on_.assign(p, 1);
@@ -137,7 +138,7 @@ std::size_t Calibrator::state_bytes() const {
   return sizeof(*this) + vb(friction_.delta_rev) + vb(friction_.stiffness_kN_per_rev) + vb(phi_kN_) +
          vb(pf_x_rev_) + vb(pf_f_kN_) + vb(pf_proj_) + (store_.bytes() - sizeof(store_)) +
          (solver_.bytes() - sizeof(solver_)) + vb(element_pos_rev_) + vb(n_now_) + vb(vel_t_s_) + vb(vel_x_rev_) + vb(start_pos_rev_) +
-         vb(gram_) + vb(rhs_) + vb(theta_) + vb(row_) + vb(n_replay_) + vb(pos_replay_) + vb(column_on_) +
+         vb(gram_) + vb(rhs_) + vb(theta_) + vb(row_) + vb(full_row_) + vb(n_replay_) + vb(pos_replay_) + vb(column_on_) +
          vb(column_map_) + vb(nonneg_flags_) + static_cast<std::size_t>(2 * config_.start_lag_n0 + 1) * sizeof(double);
 }
 
@@ -192,6 +193,37 @@ void Calibrator::start_cycle(double x_rev) {
   }
 }
 
+// Calls f(row, b) for each stored sample in time order: `row` holds the regressors of the
+// columns taking part (column_map_), `b` the target. Paper mode (no streaming states) replays
+// the elements from x0_i over the stored samples, as the flowchart does. Robust mode's target
+// is the deviation from the current curve minus the friction of the elements kept fixed.
+template <class F>
+void Calibrator::for_each_fit_row(std::size_t columns, F&& f) {
+  for (int i = 0; i < m_; ++i) pos_replay_[static_cast<std::size_t>(i)] = start_pos_rev_[static_cast<std::size_t>(i)];
+  double* full = full_row_.data();
+  double* row = row_.data();
+  for (std::size_t r = 0; r < store_.size(); ++r) {
+    const double x = store_.x_rev(r);
+    const double* n = store_.n_row(r);
+    if (!streaming_) {
+      elements_step(x, friction_.delta_rev.data(), pos_replay_.data(), static_cast<std::size_t>(m_), nullptr,
+                    n_replay_.data());
+      for (int i = 0; i < e_; ++i) n_replay_[static_cast<std::size_t>(m_ + i)] = n[m_ + i];
+      n = n_replay_.data();
+    }
+    regressor_row(x, n, full);
+    double b = store_.f_kN(r);
+    if (robust_) {
+      b -= curve_.force_kN(x);
+      for (int i = 0; i < m_; ++i) {
+        if (!column_on_[static_cast<std::size_t>(kCurveTerms + i)]) b -= phi_kN_[static_cast<std::size_t>(i)] * n[i];
+      }
+    }
+    for (std::size_t a = 0; a < columns; ++a) row[a] = full[column_map_[a]];
+    f(row, b);
+  }
+}
+
 bool Calibrator::end_cycle() {
   const std::size_t rows = store_.size();
   const double x_lo = store_.min_x_rev();
@@ -216,36 +248,15 @@ bool Calibrator::end_cycle() {
   }
   if (rows < static_cast<std::size_t>(p_on) + 2) return false;
 
+  const auto pu = static_cast<std::size_t>(p_on);
   std::fill(gram_.begin(), gram_.end(), 0.0);
   std::fill(rhs_.begin(), rhs_.end(), 0.0);
-  for (int i = 0; i < m_; ++i) pos_replay_[static_cast<std::size_t>(i)] = start_pos_rev_[static_cast<std::size_t>(i)];
-  double* row = row_.data();
-  const auto pu = static_cast<std::size_t>(p_on);
-  for (std::size_t r = 0; r < rows; ++r) {
-    const double x = store_.x_rev(r);
-    const double* n = store_.n_row(r);
-    if (!streaming_) {
-      // The paper's flowchart: replay the elements from x0_i over the stored samples.
-      elements_step(x, friction_.delta_rev.data(), pos_replay_.data(), static_cast<std::size_t>(m_), nullptr,
-                    n_replay_.data());
-      for (int i = 0; i < e_; ++i) n_replay_[static_cast<std::size_t>(m_ + i)] = n[m_ + i];
-      n = n_replay_.data();
-    }
-    double full[64 + kCurveTerms + 1];
-    regressor_row(x, n, full);
-    double b = store_.f_kN(r);
-    if (robust_) {
-      b -= curve_.force_kN(x);
-      for (int i = 0; i < m_; ++i) {
-        if (!column_on_[static_cast<std::size_t>(kCurveTerms + i)]) b -= phi_kN_[static_cast<std::size_t>(i)] * n[i];
-      }
-    }
-    for (std::size_t a = 0; a < pu; ++a) row[a] = full[column_map_[a]];
+  for_each_fit_row(pu, [&](const double* row, double b) {
     for (std::size_t a = 0; a < pu; ++a) {
       rhs_[a] += row[a] * b;
       for (std::size_t c = a; c < pu; ++c) gram_[a * pu + c] += row[a] * row[c];
     }
-  }
+  });
   for (std::size_t a = 0; a < pu; ++a) {
     for (std::size_t c = 0; c < a; ++c) gram_[a * pu + c] = gram_[c * pu + a];
   }
@@ -262,32 +273,13 @@ bool Calibrator::end_cycle() {
     if (!std::isfinite(theta_[a])) return false;
   }
 
-  // Residual RMS of the fit, from the normal equations: |b|^2 - 2 t'h + t'G t is unstable;
-  // recompute directly instead (rows <= L, cheap).
-  for (int i = 0; i < m_; ++i) pos_replay_[static_cast<std::size_t>(i)] = start_pos_rev_[static_cast<std::size_t>(i)];
+  // Residual RMS of the fit, recomputed row by row (|b|^2 - 2 t'h + t'G t cancels badly).
   double sse = 0.0;
-  for (std::size_t r = 0; r < rows; ++r) {
-    const double x = store_.x_rev(r);
-    const double* n = store_.n_row(r);
-    if (!streaming_) {
-      elements_step(x, friction_.delta_rev.data(), pos_replay_.data(), static_cast<std::size_t>(m_), nullptr,
-                    n_replay_.data());
-      for (int i = 0; i < e_; ++i) n_replay_[static_cast<std::size_t>(m_ + i)] = n[m_ + i];
-      n = n_replay_.data();
-    }
-    double full[64 + kCurveTerms + 1];
-    regressor_row(x, n, full);
+  for_each_fit_row(pu, [&](const double* row, double b) {
     double model = 0.0;
-    for (std::size_t a = 0; a < pu; ++a) model += full[column_map_[a]] * theta_[a];
-    double b = store_.f_kN(r);
-    if (robust_) {
-      b -= curve_.force_kN(x);
-      for (int i = 0; i < m_; ++i) {
-        if (!column_on_[static_cast<std::size_t>(kCurveTerms + i)]) b -= phi_kN_[static_cast<std::size_t>(i)] * n[i];
-      }
-    }
+    for (std::size_t a = 0; a < pu; ++a) model += row[a] * theta_[a];
     sse += (b - model) * (b - model);
-  }
+  });
   const double rms = std::sqrt(sse / static_cast<double>(rows));
   stats_.last_fit_rms_kN = rms;
   if (robust_ && rms > config_.max_fit_rms_kN) return false;

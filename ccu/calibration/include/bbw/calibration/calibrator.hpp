@@ -77,6 +77,8 @@ class Calibrator {
  private:
   void start_cycle(double x_rev);
   bool end_cycle();
+  template <class F>
+  void for_each_fit_row(std::size_t columns, F&& f);
   void refit_curve_from_pf();
   void regressor_row(double x_rev, const double* n, double* row) const;
   double poly_basis_x(double x_rev, int power) const;
@@ -122,7 +124,8 @@ class Calibrator {
   std::vector<double> gram_;
   std::vector<double> rhs_;
   std::vector<double> theta_;
-  std::vector<double> row_;
+  std::vector<double> row_;       // regressors of the columns taking part
+  std::vector<double> full_row_;  // all p_ regressors of one sample
   std::vector<double> n_replay_;
   std::vector<double> pos_replay_;
   std::vector<char> column_on_;
