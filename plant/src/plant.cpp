@@ -58,7 +58,7 @@ void Plant::reset(double position_rev) {
   sample_sensors();
 }
 
-void Plant::substep(double i_cmd_A, double h_s) {
+void Plant::substep(double i_cmd_A, double torque_scale, double h_s) {
   const auto& m = p_.motor;
   const auto& t = p_.transmission;
   // Current: first-order R/L lag towards the (clipped) command.
@@ -77,7 +77,7 @@ void Plant::substep(double i_cmd_A, double h_s) {
   const double drive_friction_Nm = t.coulomb_friction_Nm * std::tanh(v / t.coulomb_smoothing_rev_per_s) +
                                    t.viscous_friction_Nm_per_rev_per_s * v;
   const double accel_rev_s2 =
-      (torque_per_A_Nm_ * s_.current_A - load_Nm - drive_friction_Nm) / (inertia_kg_m2_ * kTwoPi);
+      (torque_scale * torque_per_A_Nm_ * s_.current_A - load_Nm - drive_friction_Nm) / (inertia_kg_m2_ * kTwoPi);
   // Semi-implicit Euler: speed first, then position with the new speed.
   s_.speed_rev_per_s += h_s * accel_rev_s2;
   s_.motor_position_rev += h_s * s_.speed_rev_per_s;
@@ -105,12 +105,13 @@ const Measurement& Plant::step(const PlantInputs& inputs, double dt_s) {
   if (!(dt_s > 0.0)) return meas_;  // time does not run backwards; nothing happens
   const double limit = p_.motor.current_limit_A;
   const double i_cmd = std::clamp(inputs.current_command_A, -limit, limit);
+  const double torque_scale = std::clamp(inputs.torque_scale, 0.0, 1.0);
   const int n = p_.substeps;
   const double h = dt_s / n;
   for (int k = 0; k < n; ++k) {
     s_.time_s += h;
     s_.temperature_C = c_.temperature_C + c_.temperature_rate_C_per_s * s_.time_s;
-    substep(i_cmd, h);
+    substep(i_cmd, torque_scale, h);
   }
   // Key friction: rate-independent, so one update per step at the step's end position is
   // exact for a position that moves monotonically within the step.

@@ -1,5 +1,6 @@
 #include "bbw/scenario/corner_sim.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace bbw::scenario {
@@ -55,6 +56,10 @@ CornerSim::CornerSim(const Scenario& scenario, std::size_t index)
     }
   }
   const plant::Measurement& m = plant_.measurement();
+  readings_ = m;
+  held_position_rev_ = m.position_rev;
+  held_speed_rev_per_s_ = m.speed_rev_per_s;
+  held_load_cell_kN_ = m.force_internal_kN;
   sample_.position_rev = m.position_rev;
   sample_.force_internal_kN = m.force_internal_kN;
   sample_.force_external_kN = m.force_external_kN;
@@ -66,11 +71,16 @@ CornerSim::CornerSim(const Scenario& scenario, std::size_t index)
 const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
   if (!(dt_s > 0.0)) return sample_;
   const double t_next = time_s_ + dt_s;
-  const plant::Measurement& m = plant_.measurement();
+  // The controller sees the readings as delivered, with non-finite ones held at the last
+  // finite value (a sensor that gave no value this step).
+  const plant::Measurement& m = readings_;
+  if (std::isfinite(m.position_rev)) held_position_rev_ = m.position_rev;
+  if (std::isfinite(m.speed_rev_per_s)) held_speed_rev_per_s_ = m.speed_rev_per_s;
+  if (std::isfinite(m.force_internal_kN)) held_load_cell_kN_ = m.force_internal_kN;
   corner_unit::ControllerInputs in;
-  in.position_rev = m.position_rev;
-  in.speed_rev_per_s = m.speed_rev_per_s;
-  in.load_force_kN = m.force_internal_kN;
+  in.position_rev = held_position_rev_;
+  in.speed_rev_per_s = held_speed_rev_per_s_;
+  in.load_force_kN = held_load_cell_kN_;
   corner_unit::ControllerOutput out;
   const bool force_mode = ext.force_command_kN.has_value() || mode_ != DriveMode::Position;
   if (force_mode) {
@@ -83,11 +93,13 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
       rate = force_scale_ * r.rate;
     }
     corner_unit::ForceSources src;
-    src.load_cell_kN = m.force_internal_kN;
+    src.load_cell_kN = held_load_cell_kN_;
     src.friction_estimate_kN = ext.friction_estimate_kN;
-    src.curve_estimate_kN = ext.curve ? ext.curve->force_kN(m.position_rev) : m.force_internal_kN;
+    src.curve_estimate_kN = ext.curve ? ext.curve->force_kN(held_position_rev_) : held_load_cell_kN_;
     src.true_kN = plant_.state().force_true_kN;
-    const auto fb = mode_ == DriveMode::Position ? corner_unit::ForceFeedback::LoadCell : feedback_;
+    const auto fb = ext.feedback ? *ext.feedback
+                    : mode_ == DriveMode::Position ? corner_unit::ForceFeedback::LoadCell
+                                                   : feedback_;
     in.force_feedback_kN = corner_unit::select_force(fb, src);
     out = controller_.update_force(cmd, in, dt_s, rate);
     sample_.command_kind = CommandKind::Force;
@@ -101,7 +113,9 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
   sample_.force_feedback_kN = in.force_feedback_kN;
   sample_.current_command_A = out.current_command_A;
 
-  const plant::Measurement& y = plant_.step(plant::PlantInputs{out.current_command_A}, dt_s);
+  readings_ = plant_.step(plant::PlantInputs{out.current_command_A, ext.torque_scale}, dt_s);
+  if (ext.sensor_hook != nullptr) ext.sensor_hook->apply(readings_);
+  const plant::Measurement& y = readings_;
   const plant::PlantState& s = plant_.state();
   time_s_ = t_next;
   sample_.seq = ++seq_;

@@ -18,6 +18,9 @@ namespace bbw::plant {
 
 struct PlantInputs {
   double current_command_A = 0.0;  // to the power stage; clipped to +/- current_limit_A
+  // Fault injection (docs/faults.md): the fraction of the motor's torque that reaches the
+  // spindle, in [0, 1]; 1 is a healthy actuator. The current (and its sensor) is unaffected.
+  double torque_scale = 1.0;
 };
 
 // Physical state (the truth).
@@ -76,7 +79,7 @@ class Plant {
   double resolver_quantum_rev() const { return quantum_rev_; }
 
  private:
-  void substep(double i_cmd_A, double h_s);
+  void substep(double i_cmd_A, double torque_scale, double h_s);
   void sample_sensors();
 
   PlantParams p_;

@@ -43,6 +43,18 @@ struct CurveEstimate {
   double force_kN(double x_rev) const { return ((a * x_rev + b) * x_rev + c) * x_rev + d; }
 };
 
+// A hook between the sensors and everything that reads them (fault injection, docs/faults.md):
+// called once per step with the new readings, before the sample and the local controller see
+// them. It may change any reading; a non-finite reading reaches the sample as it is, while the
+// local controller keeps using the last finite value of that channel.
+class SensorHook {
+ public:
+  virtual void apply(plant::Measurement& readings) = 0;
+
+ protected:
+  ~SensorHook() = default;
+};
+
 // What the outside (the CCU) may supply each step.
 struct ExternalInputs {
   // A clamp-force command; when present it replaces the profile and the corner runs in force
@@ -53,6 +65,13 @@ struct ExternalInputs {
   double friction_estimate_kN = 0.0;
   // For feedback `curve`: the calibrated curve; without one the load cell is used.
   std::optional<CurveEstimate> curve;
+  // Replaces the corner's force-feedback choice in force mode (a CCU fault reaction: a faulty
+  // load cell -> Curve). Position-driven corners without a force command are unaffected.
+  std::optional<corner_unit::ForceFeedback> feedback;
+  // Fault injection (docs/faults.md): the plant's torque scale for this step (1 = healthy) and
+  // an optional sensor hook; neither changes anything at their defaults.
+  double torque_scale = 1.0;
+  SensorHook* sensor_hook = nullptr;
 };
 
 class CornerSim {
@@ -82,6 +101,10 @@ class CornerSim {
   double force_scale_ = 1.0;        // demand drive: axle factor * max clamp force
   double time_s_ = 0.0;
   std::uint64_t seq_ = 0;
+  plant::Measurement readings_;     // the sensor readings as seen (after any SensorHook)
+  double held_position_rev_ = 0.0;  // last finite readings, for the local controller
+  double held_speed_rev_per_s_ = 0.0;
+  double held_load_cell_kN_ = 0.0;
   CornerSample sample_;
 };
 

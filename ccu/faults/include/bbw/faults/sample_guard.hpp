@@ -1,0 +1,66 @@
+// The CCU's corrupt-sample guard (docs/faults.md, "Corrupt samples"): a sample that is
+// non-finite, out of range, or whose sequence or time does not move forward is never used for
+// an estimate or a command; each is counted by reason. A load cell that gives no value (NaN)
+// with the rest intact is a dropout: the sample is usable, its load-cell channel is not.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "bbw/faults/reading.hpp"
+
+namespace bbw::faults {
+
+struct GuardLimits {
+  double position_min_rev = -1.0;
+  double position_max_rev = 10.0;
+  double speed_abs_max_rev_per_s = 200.0;
+  double load_cell_min_kN = -5.0;
+  double load_cell_max_kN = 80.0;
+  double current_abs_max_A = 80.0;
+
+  void validate() const;  // throws std::invalid_argument naming the field
+};
+
+enum class SampleIssue : std::uint8_t {
+  None,
+  NonFinite,          // NaN or inf anywhere except a NaN load cell
+  OutOfRange,
+  Duplicate,          // the same sequence number again
+  SequenceBackwards,  // a sequence number below the last one accepted
+  TimeBackwards,      // time not after the last accepted sample's
+};
+inline constexpr std::size_t kSampleIssueCount = 6;
+const char* to_string(SampleIssue i);
+
+struct SampleCheck {
+  SampleIssue issue = SampleIssue::None;
+  bool load_cell_present = true;   // false for a dropout (or when the sample is unusable)
+  bool usable() const { return issue == SampleIssue::None; }
+};
+
+class SampleGuard {
+ public:
+  explicit SampleGuard(const GuardLimits& limits);  // throws std::invalid_argument
+
+  SampleCheck check(const CornerReading& r);
+  // A new incarnation of the corner (a restarted process): its sequence may start again.
+  void rejoin();
+
+  std::uint64_t count(SampleIssue i) const { return counts_[static_cast<std::size_t>(i)]; }
+  std::uint64_t rejected() const;
+  std::uint64_t load_cell_missing() const { return load_cell_missing_; }
+  std::uint64_t last_seq() const { return last_seq_; }
+  double last_time_s() const { return last_time_s_; }
+  bool has_accepted() const { return have_last_; }
+
+ private:
+  GuardLimits limits_;
+  bool have_last_ = false;
+  std::uint64_t last_seq_ = 0;
+  double last_time_s_ = 0.0;
+  std::array<std::uint64_t, kSampleIssueCount> counts_{};
+  std::uint64_t load_cell_missing_ = 0;
+};
+
+}  // namespace bbw::faults

@@ -1,0 +1,149 @@
+#include "bbw/faults/corner_supervisor.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace bbw::faults {
+namespace {
+
+MonitorParams with_curve_range(MonitorParams p, const calibration::CalibratorConfig& c) {
+  p.curve_min_rev = c.x_min_rev;
+  p.curve_max_rev = c.x_max_rev;
+  return p;
+}
+
+}  // namespace
+
+const char* to_string(EstimateSource s) {
+  switch (s) {
+    case EstimateSource::None: return "none";
+    case EstimateSource::Calibrator: return "calibrator";
+    case EstimateSource::Curve: return "curve";
+    case EstimateSource::LoadCell: return "load_cell";
+  }
+  return "?";
+}
+
+CornerSupervisor::CornerSupervisor(const calibration::CalibratorConfig& calibrator, const MonitorParams& monitor,
+                                   Target corner)
+    : config_(calibrator),
+      corner_(corner),
+      guard_(monitor.guard),
+      calibrator_(std::in_place, calibrator),
+      monitor_(with_curve_range(monitor, calibrator), corner),
+      last_good_(*calibrator_),
+      trusted_curve_(calibrator.initial_curve) {
+  view_.curve = trusted_curve_;
+  view_.force_limit_kN = monitor.force_limit_kN;
+}
+
+void CornerSupervisor::on_link_event(LinkEvent e, double time_s) {
+  monitor_.on_link_event(e, time_s);
+  refresh_view(nullptr, nullptr, nullptr);
+}
+
+const CornerView& CornerSupervisor::tick(double now_s) {
+  monitor_.tick(now_s);
+  refresh_view(nullptr, nullptr, nullptr);
+  return view_;
+}
+
+void CornerSupervisor::rejoin() {
+  // The corner is back (after silence or a restart): its sequence may start again, and the
+  // calibrator restarts from the last good curve and friction stiffnesses (its cycle state
+  // does not survive the gap).
+  guard_.rejoin();
+  const CalibrationSnapshot& good = last_good_.newest();
+  calibration::CalibratorConfig cfg = config_;
+  cfg.initial_curve = good.curve;
+  calibrator_.emplace(cfg);
+  calibrator_->set_friction_stiffness(good.stiffness_kN_per_rev);
+  ++restarts_;
+}
+
+void CornerSupervisor::react_to_new_findings() {
+  if (!monitor_.ok(Part::LoadCell) && !load_cell_reacted_) {
+    // Back to the newest curve fitted before the fault began; the load cell is no longer used.
+    load_cell_reacted_ = true;
+    trusted_curve_ = last_good_.before(monitor_.diagnosis(Part::LoadCell).onset_s).curve;
+  }
+  if (!monitor_.ok(Part::Resolver) && !resolver_reacted_) {
+    resolver_reacted_ = true;
+    frozen_friction_kN_ = last_friction_kN_;
+  }
+}
+
+const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arrival_s) {
+  const bool was_lost = !monitor_.ok(Part::Network) || !monitor_.ok(Part::Process);
+  if (was_lost) guard_.rejoin();
+  const SampleCheck check = guard_.check(r);
+  calibration::Estimate e;
+  const calibration::Estimate* fed = nullptr;
+  const bool sensors_ok = monitor_.ok(Part::LoadCell) && monitor_.ok(Part::Resolver);
+  if (check.usable() && check.load_cell_present && sensors_ok && !was_lost) {
+    e = calibrator_->update(calibration::Sample{r.time_s, r.position_rev, r.load_cell_kN});
+    fed = &e;
+    ++fed_;
+    if (e.valid) {
+      fed_min_rev_ = std::min(fed_min_rev_, r.position_rev);
+      fed_max_rev_ = std::max(fed_max_rev_, r.position_rev);
+    }
+  }
+  // The estimate the monitor checks tracking against: the current view's rule on this sample.
+  refresh_view(check.usable() ? &r : nullptr, &check, fed);
+  monitor_.update(r, check, fed, view_.force_estimate_kN, arrival_s);
+  if (monitor_.take_rejoin()) rejoin();
+  react_to_new_findings();
+  if (fed != nullptr && e.valid) {
+    if (e.fit_accepted && monitor_.ok(Part::LoadCell) && monitor_.ok(Part::Resolver)) {
+      last_good_.push(r.time_s, *calibrator_);
+      monitor_.set_curve_range(fed_min_rev_, fed_max_rev_);  // the fits had data here
+    }
+    if (monitor_.ok(Part::Resolver)) last_friction_kN_ = e.friction_kN;
+  }
+  refresh_view(check.usable() ? &r : nullptr, &check, fed);
+  return view_;
+}
+
+void CornerSupervisor::refresh_view(const CornerReading* r, const SampleCheck* c, const calibration::Estimate* e) {
+  const bool lc_ok = monitor_.ok(Part::LoadCell);
+  const bool res_ok = monitor_.ok(Part::Resolver);
+  const bool linked = monitor_.ok(Part::Network) && monitor_.ok(Part::Process);
+  if (r != nullptr) {
+    const bool lc_present = c->load_cell_present;
+    if (lc_ok && res_ok && e != nullptr && e->valid) {
+      view_.force_estimate_kN = e->force_kN;
+      view_.source = EstimateSource::Calibrator;
+    } else if (res_ok && (!lc_ok || !lc_present)) {
+      const calibration::Curve& curve = lc_ok ? calibrator_->curve() : trusted_curve_;
+      // A clamp force is never negative; below the fitted range the cubic can be.
+      view_.force_estimate_kN = std::max(0.0, curve.force_kN(r->position_rev));
+      view_.source = EstimateSource::Curve;
+    } else if (!res_ok && lc_ok && lc_present) {
+      view_.force_estimate_kN = r->load_cell_kN - frozen_friction_kN_;
+      view_.source = EstimateSource::LoadCell;
+    } else {
+      view_.force_estimate_kN = std::numeric_limits<double>::quiet_NaN();
+      view_.source = EstimateSource::None;
+    }
+  }
+  if (!linked) {
+    view_.force_estimate_kN = std::numeric_limits<double>::quiet_NaN();
+    view_.source = EstimateSource::None;
+  }
+  const Diagnosis& act = monitor_.diagnosis(Part::Actuator);
+  const bool actuator_usable = !act.active || act.finding == Finding::ActuatorTorqueLoss;
+  const bool sensing = lc_ok || res_ok;
+  view_.available = linked && actuator_usable && sensing;
+  view_.force_limit_kN = monitor_.params().force_limit_kN;
+  if (!lc_ok && res_ok) {
+    view_.feedback = corner_unit::ForceFeedback::Curve;
+  } else if (!res_ok) {
+    view_.feedback = corner_unit::ForceFeedback::LoadCell;
+  } else {
+    view_.feedback.reset();
+  }
+  view_.curve = lc_ok ? calibrator_->curve() : trusted_curve_;
+}
+
+}  // namespace bbw::faults

@@ -1,0 +1,68 @@
+// A scenario's fault schedule (docs/faults.md): at a simulated time, on a corner or the CCU, a
+// fault of one part with its parameters and an optional duration. Plain structs; the YAML
+// reader is in bbw/faults/schedule_yaml.hpp.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace bbw::faults {
+
+enum class Target { FL, FR, RL, RR, CCU };
+enum class Part { LoadCell, Resolver, Actuator, Network, Process };
+enum class FaultType {
+  Bias,        // load cell: + bias_kN
+  Drift,       // load cell: + rate_kN_per_s * (t - at_s)
+  Stuck,       // load cell or resolver: the reading freezes at its last value
+  NoiseBurst,  // load cell: + Gaussian noise of rms_kN
+  Dropout,     // load cell: no value (NaN)
+  Offset,      // resolver: + offset_rev
+  TorqueLoss,  // actuator: torque_loss_percent of the motor torque is lost
+  TotalLoss,   // actuator: no motor torque
+  Silence,     // network: the corner's messages stop (for duration_s, required)
+  Delay,       // network: the corner's messages arrive delay_ms late
+  Kill,        // process: the corner (or CCU) process is killed; optionally restarted
+};
+
+struct FaultSpec {
+  double at_s = 0.0;
+  Target target = Target::FL;
+  Part part = Part::LoadCell;
+  FaultType type = FaultType::Bias;
+  std::optional<double> duration_s;     // absent: until the end of the run
+  // Parameters; each type uses only its own (the others stay 0 / empty).
+  double bias_kN = 0.0;
+  double rate_kN_per_s = 0.0;
+  double rms_kN = 0.0;
+  double offset_rev = 0.0;
+  double torque_loss_percent = 0.0;
+  double delay_ms = 0.0;
+  std::optional<double> restart_after_s;  // process kill
+  int line = 0;                           // where it was read from (0 when built in code)
+
+  // Active in [at_s, at_s + duration_s); a kill is active until the restart (if any).
+  bool active_at(double time_s) const;
+  double end_s() const;  // +inf when it never ends
+};
+
+struct FaultSchedule {
+  std::vector<FaultSpec> faults;  // in file order
+
+  // The faults of one target, in file order (allocates; call at set-up).
+  std::vector<FaultSpec> for_target(Target t) const;
+  bool empty() const { return faults.empty(); }
+};
+
+const char* to_string(Target t);
+const char* to_string(Part p);
+const char* to_string(FaultType t);
+// "FL" -> Target::FL ...; nullopt for anything else.
+std::optional<Target> target_from_name(std::string_view name);
+// The corner index of FL/FR/RL/RR in that order (the CCU has none).
+std::optional<std::size_t> corner_slot(Target t);
+// Which part a type belongs to (Stuck belongs to both sensors: nullopt).
+std::optional<Part> part_of(FaultType t);
+
+}  // namespace bbw::faults
