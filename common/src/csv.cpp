@@ -89,6 +89,8 @@ Table read(const std::string& file, const ReadOptions& options) {
   struct stat st {};
   if (::stat(file.c_str(), &st) != 0) throw CsvError(file + ": cannot open file");
   if (S_ISDIR(st.st_mode)) throw CsvError(file + ": is a directory, not a CSV file");
+  // A FIFO or a device would block on open or never end.
+  if (!S_ISREG(st.st_mode)) throw CsvError(file + ": is not a regular file");
   if (static_cast<std::uint64_t>(st.st_size) > options.max_bytes) {
     throw CsvError(file + ": file is " + std::to_string(st.st_size) + " bytes, more than the limit of " +
                    std::to_string(options.max_bytes));

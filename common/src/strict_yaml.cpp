@@ -1,11 +1,17 @@
 #include "bbw/common/strict_yaml.hpp"
 
+#include <sys/stat.h>
+
 #include <cmath>
+#include <set>
 #include <sstream>
 
 namespace bbw::config {
 
 namespace {
+
+// Config files are a few kB; anything near this limit is a mistake or an attack.
+constexpr std::uint64_t kMaxConfigBytes = 4u << 20;
 
 std::string format_message(const std::string& file, int line, const std::string& key_path,
                            const std::string& rule) {
@@ -73,26 +79,54 @@ Reader::Reader(YAML::Node node, std::string file, std::string path)
     throw ConfigError(file_, mark_line(node_), path_,
                       std::string("must be a mapping of keys to values, got ") + type_name(node_));
   }
+  // yaml-cpp keeps every duplicate and node[key] returns the first: a repeated key would
+  // silently shadow the later value. Keys must also be plain scalars.
+  std::set<std::string> seen;
+  for (const auto& kv : node_) {
+    if (!kv.first.IsScalar()) {
+      throw ConfigError(file_, mark_line(kv.first), path_,
+                        std::string("keys must be plain names, got ") + type_name(kv.first));
+    }
+    const std::string& k = kv.first.Scalar();
+    if (!seen.insert(k).second) {
+      throw ConfigError(file_, mark_line(kv.first), child_path(k), "duplicate key");
+    }
+  }
 }
 
 Reader Reader::from_file(const std::string& file) {
+  // Refuse what is not a small regular file before yaml-cpp opens it: a directory makes it
+  // throw std::ios_base::failure, a FIFO or a device would block or never end.
+  struct stat st {};
+  if (::stat(file.c_str(), &st) != 0) throw ConfigError(file, 0, "", "cannot open file");
+  if (!S_ISREG(st.st_mode)) throw ConfigError(file, 0, "", "is not a regular file");
+  if (static_cast<std::uint64_t>(st.st_size) > kMaxConfigBytes) {
+    throw ConfigError(file, 0, "", "file is " + std::to_string(st.st_size) + " bytes, more than the limit of " +
+                                       std::to_string(kMaxConfigBytes));
+  }
   YAML::Node root;
   try {
     root = YAML::LoadFile(file);
   } catch (const YAML::BadFile&) {
     throw ConfigError(file, 0, "", "cannot open file");
-  } catch (const YAML::ParserException& e) {
+  } catch (const YAML::Exception& e) {
     throw ConfigError(file, e.mark.line >= 0 ? e.mark.line + 1 : 0, "",
                       "YAML syntax error: " + e.msg);
+  } catch (const std::exception& e) {
+    throw ConfigError(file, 0, "", std::string("cannot read file: ") + e.what());
   }
   return Reader(root, file, "");
 }
 
 Reader Reader::from_string(const std::string& text, const std::string& name) {
+  if (text.size() > kMaxConfigBytes) {
+    throw ConfigError(name, 0, "", "text is " + std::to_string(text.size()) + " bytes, more than the limit of " +
+                                       std::to_string(kMaxConfigBytes));
+  }
   YAML::Node root;
   try {
     root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
+  } catch (const YAML::Exception& e) {
     throw ConfigError(name, e.mark.line >= 0 ? e.mark.line + 1 : 0, "",
                       "YAML syntax error: " + e.msg);
   }
