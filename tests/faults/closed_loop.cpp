@@ -126,7 +126,7 @@ LoopResult run_closed_loop(const FaultScenario& fs, const LoopOptions& options) 
       std::array<CornerCapacity, kCorners> cap;
       for (std::size_t i = 0; i < kCorners; ++i) {
         const CornerView& v = ccu[i]->view();
-        cap[i] = {v.available, v.force_limit_kN};
+        cap[i] = {options.redistribute ? v.available : true, v.force_limit_kN};
         rec.available[i] = v.available;
       }
       const Allocation a = redistributor.allocate(demand_total, cap);
@@ -201,6 +201,7 @@ LoopResult run_closed_loop(const FaultScenario& fs, const LoopOptions& options) 
       ccu[i]->tick(t1);
       rec.estimate_kN[i] = ccu[i]->view().force_estimate_kN;
       rec.residual_kN[i] = ccu[i]->monitor().last_residual_kN();
+      rec.residual_change_kN[i] = ccu[i]->monitor().last_residual_change_kN();
       rec.noise_kN[i] = ccu[i]->monitor().last_noise_fraction();
     }
     out.periods.push_back(rec);

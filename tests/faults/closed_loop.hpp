@@ -25,7 +25,8 @@ struct LoopOptions {
   calibration::CalibratorConfig calibrator;
   MonitorParams monitor;          // actuator model fields are taken from the scenario's plant
   CcuWatchdogParams watchdog;
-  double liveliness_lease_s = 0.02;  // a killed corner is reported LivelinessLost after this
+  double liveliness_lease_s = 0.02;
+  bool redistribute = true;          // false: the CCU keeps the nominal split (for comparison)  // a killed corner is reported LivelinessLost after this
   // Called for every reading a corner sends; fills `out` with what reaches the CCU (default:
   // the reading itself). Tests add corrupt samples here.
   std::function<void(std::size_t corner, const CornerReading& r, std::vector<CornerReading>& out)> deliver;
@@ -44,6 +45,7 @@ struct PeriodRecord {
   std::array<bool, kCorners> available{};
   std::array<double, kCorners> residual_kN{};  // the monitor's last analytic-redundancy residual
   std::array<double, kCorners> noise_kN{};
+  std::array<double, kCorners> residual_change_kN{};
   bool ccu_alive = true;
 };
 

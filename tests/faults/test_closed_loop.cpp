@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "closed_loop.hpp"
 
@@ -13,7 +14,26 @@ namespace {
 
 FaultScenario load(const std::string& rel) { return load_fault_scenario(source_path(rel)); }
 
+// The campaign scenarios hold a stop from 10 s to 13 s and inject at 11 s.
+constexpr double kFaultAt = 11.0;
+constexpr double kStopEnd = 13.0;
+
 }  // namespace
+
+TEST(ClosedLoop, EveryFaultFreeVehicleScenarioRaisesNoFault) {
+  // Every scenario with a pedal demand and the four vehicle corners, in config/scenarios/.
+  std::size_t runs = 0;
+  for (const char* rel : {"config/scenarios/vehicle_stop.yaml", "config/scenarios/faults/fault_free_stop.yaml"}) {
+    const auto fs = load(rel);
+    ASSERT_TRUE(fs.faults.empty());
+    const auto r = run_closed_loop(fs, default_options());
+    for (std::size_t k = 0; k < r.diagnoses.size(); ++k) {
+      if (r.diagnoses[k].present) ADD_FAILURE() << rel << ": " << to_string(r.diagnoses[k].finding) << " at " << r.diagnoses[k].detected_s;
+    }
+    ++runs;
+  }
+  EXPECT_EQ(runs, 2u);
+}
 
 TEST(ClosedLoop, FaultFreeStopRaisesNoFault) {
   const auto fs = load("config/scenarios/faults/fault_free_stop.yaml");
@@ -30,22 +50,23 @@ TEST(ClosedLoop, FaultFreeStopRaisesNoFault) {
   for (const auto& p : r.periods) {
     for (std::size_t i = 0; i < kCorners; ++i) {
       const double e = std::abs(p.estimate_kN[i] - p.true_kN[i]);
-      if (p.time_s > 6.0 && e > worst) {
+      if (p.time_s > 10.0 && e > worst) {
         worst = e;
         worst_t = p.time_s;
       }
     }
   }
-  std::array<double, kCorners> rmax{}, nmax{}, rhold{};
+  std::array<double, kCorners> rmax{}, nmax{}, rhold{}, cmax{};
   for (const auto& p : r.periods) {
     for (std::size_t i = 0; i < kCorners; ++i) {
-      if (p.time_s > 3.0 && std::isfinite(p.residual_kN[i])) rmax[i] = std::max(rmax[i], std::abs(p.residual_kN[i]));
+      if (p.time_s > 5.0 && std::isfinite(p.residual_kN[i])) rmax[i] = std::max(rmax[i], std::abs(p.residual_kN[i]));
       nmax[i] = std::max(nmax[i], p.noise_kN[i]);
-      if (p.time_s > 6.0 && std::isfinite(p.residual_kN[i])) rhold[i] = std::max(rhold[i], std::abs(p.residual_kN[i]));
+      if (p.time_s > 5.0 && std::isfinite(p.residual_change_kN[i])) cmax[i] = std::max(cmax[i], std::abs(p.residual_change_kN[i]));
+      if (p.time_s > 10.0 && std::isfinite(p.residual_kN[i])) rhold[i] = std::max(rhold[i], std::abs(p.residual_kN[i]));
     }
   }
-  for (std::size_t i = 0; i < kCorners; ++i) std::printf("corner %zu: max |residual| after 3 s %.3f kN, after 6 s %.3f kN, max noise %.3f kN\n", i, rmax[i], rhold[i], nmax[i]);
-  std::printf("worst estimate error after 6 s: %.3f kN at %.3f s\n", worst, worst_t);
+  for (std::size_t i = 0; i < kCorners; ++i) std::printf("corner %zu: max |residual| after 5 s %.3f kN, after 10 s %.3f kN; max |change| after 5 s %.3f kN; max large-step share %.3f\n", i, rmax[i], rhold[i], cmax[i], nmax[i]);
+  std::printf("worst estimate error after 10 s: %.3f kN at %.3f s\n", worst, worst_t);
   EXPECT_EQ(r.faults_raised(), 0u);
 }
 
@@ -61,22 +82,203 @@ const std::vector<std::string>& campaign() {
 
 }  // namespace
 
-TEST(ClosedLoop, CampaignTable) {
+
+namespace {
+
+FaultScenario with_fault(const FaultSpec& f) {
+  auto fs = load("config/scenarios/faults/fault_free_stop.yaml");
+  fs.faults.faults.push_back(f);
+  check_schedule(fs.scenario, fs.faults);
+  return fs;
+}
+
+FaultSpec fault(Target c, Part p, FaultType t, double at_s = kFaultAt) {
+  FaultSpec f;
+  f.at_s = at_s;
+  f.target = c;
+  f.part = p;
+  f.type = t;
+  return f;
+}
+
+constexpr std::array<Target, kCorners> kAll = {Target::FL, Target::FR, Target::RL, Target::RR};
+
+}  // namespace
+
+TEST(ClosedLoop, EveryCampaignScenarioIsDetectedAndIsolatedWithNoOtherFinding) {
   std::printf("%-24s %-6s %-10s %-12s %9s  %-22s %-7s %s\n", "scenario", "corner", "part", "type", "latency", "diagnosis",
               "correct", "delivered");
   for (const auto& n : campaign()) {
     const auto fs = load("config/scenarios/faults/" + n + ".yaml");
     const auto r = run_closed_loop(fs, default_options());
-    for (const auto& o : r.outcomes) {
-      std::printf("%-24s %-6s %-10s %-12s %7.1f ms  %-22s %-7s %.3f\n", n.c_str(), to_string(o.fault.target),
-                  to_string(o.fault.part), to_string(o.fault.type), o.detected ? o.latency_ms : -1.0,
-                  to_string(o.diagnosis), o.correct ? "yes" : "no", o.delivered_share);
+    const FaultSpec& f = fs.faults.faults.at(0);
+    if (f.target == Target::CCU) {
+      EXPECT_EQ(r.faults_raised(), 0u) << n;  // the CCU's death is handled by the corners
+      continue;
     }
+    ASSERT_EQ(r.outcomes.size(), 1u);
+    const auto& o = r.outcomes[0];
+    std::printf("%-24s %-6s %-10s %-12s %7.1f ms  %-22s %-7s %.3f\n", n.c_str(), to_string(o.fault.target),
+                to_string(o.fault.part), to_string(o.fault.type), o.detected ? o.latency_ms : -1.0,
+                to_string(o.diagnosis), o.correct ? "yes" : "no", o.delivered_share);
+    EXPECT_TRUE(o.detected) << n;
+    EXPECT_TRUE(o.correct) << n << ": " << to_string(o.diagnosis);
+    EXPECT_GE(o.latency_ms, 0.0) << n;
+    const std::size_t slot = *corner_slot(f.target);
     for (std::size_t i = 0; i < kCorners; ++i) {
       for (std::size_t p = 0; p < 5; ++p) {
         const auto& d = r.diagnoses[i * 5 + p];
-        if (d.present) std::printf("    corner %zu raised %s at %.3f s\n", i, to_string(d.finding), d.detected_s);
+        const bool expected_corner = i == slot;
+        const bool kill_link = f.type == FaultType::Kill && static_cast<Part>(p) == Part::Network;
+        if (d.present && !(expected_corner && (static_cast<Part>(p) == f.part || kill_link))) {
+          ADD_FAILURE() << n << ": corner " << i << " also raised " << to_string(d.finding) << " at " << d.detected_s;
+        }
       }
     }
   }
+}
+
+TEST(ClosedLoop, LoadCellBiasOfOneKilonewtonIsIsolatedWithin100msAndTheCurveEstimateIsWithinHalfAKilonewton) {
+  std::printf("%-6s %8s %10s %14s\n", "corner", "bias_kN", "latency", "max |error|");
+  for (Target c : kAll) {
+    for (double bias : {1.0, -1.0, 2.0, -2.0}) {
+      auto f = fault(c, Part::LoadCell, FaultType::Bias);
+      f.bias_kN = bias;
+      const auto r = run_closed_loop(with_fault(f), default_options());
+      ASSERT_EQ(r.outcomes.size(), 1u);
+      const auto& o = r.outcomes[0];
+      const std::size_t i = *corner_slot(c);
+      double worst = 0.0;
+      for (const auto& p : r.periods) {
+        if (p.time_s >= o.detected_s + 0.05 && p.time_s <= kStopEnd) {
+          worst = std::max(worst, std::abs(p.estimate_kN[i] - p.true_kN[i]));
+        }
+      }
+      std::printf("%-6s %8.1f %7.1f ms %11.3f kN\n", to_string(c), bias, o.latency_ms, worst);
+      EXPECT_TRUE(o.detected && o.correct) << to_string(c) << " " << bias;
+      EXPECT_EQ(o.diagnosis, Finding::LoadCellOffset);
+      EXPECT_LE(o.latency_ms, 100.0) << to_string(c) << " " << bias;
+      EXPECT_LT(worst, 0.5) << to_string(c) << " " << bias;
+      EXPECT_EQ(r.faults_raised(), 1u) << to_string(c) << " " << bias;
+    }
+  }
+}
+
+TEST(ClosedLoop, OneCornerLostDuringAStopTotalBackAbove90PercentWithin100ms) {
+  // Remaining limits: 3 x 40 kN = 120 kN, more than the 66.7 kN demanded at 0.5.
+  std::printf("%-6s %-11s %10s %14s %18s\n", "corner", "loss", "detected", "recovered", "lowest share");
+  for (Target c : kAll) {
+    for (FaultType t : {FaultType::TotalLoss, FaultType::Kill}) {
+      const auto f = fault(c, t == FaultType::Kill ? Part::Process : Part::Actuator, t);
+      const auto fs = with_fault(f);
+      const auto r = run_closed_loop(fs, default_options());
+      const double rec = recovery_time_s(r, 0.9, kFaultAt, kStopEnd, 120.0);
+      double lowest = 1e9;
+      for (const auto& p : r.periods) {
+        if (p.time_s >= kFaultAt && p.time_s <= kStopEnd) lowest = std::min(lowest, p.delivered_total_kN / p.demand_total_kN);
+      }
+      std::printf("%-6s %-11s %7.1f ms %11.1f ms %17.3f\n", to_string(c), to_string(t), r.outcomes[0].latency_ms,
+                  1e3 * (rec - kFaultAt), lowest);
+      EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << to_string(c) << " " << to_string(t);
+      ASSERT_GT(rec, 0.0) << to_string(c) << " " << to_string(t);
+      EXPECT_LE(rec - kFaultAt, 0.100 + 1e-9) << to_string(c) << " " << to_string(t);
+      // Without redistribution the same loss leaves the total short of 90 %.
+      auto no = default_options();
+      no.redistribute = false;
+      const auto base = run_closed_loop(fs, no);
+      EXPECT_LT(recovery_time_s(base, 0.9, kFaultAt, kStopEnd, 120.0), 0.0) << to_string(c) << " " << to_string(t);
+    }
+  }
+}
+
+TEST(ClosedLoop, CorruptSamplesNeverChangeACommandOrAnEstimate) {
+  const auto fs = load("config/scenarios/faults/fault_free_stop.yaml");
+  const auto clean = run_closed_loop(fs, default_options());
+  auto o = default_options();
+  std::uint64_t added = 0;
+  o.deliver = [&](std::size_t corner, const CornerReading& r, std::vector<CornerReading>& out) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    out.push_back(r);
+    if (r.seq % 7 != static_cast<std::uint64_t>(corner)) return;
+    CornerReading bad = r;
+    switch ((r.seq / 7) % 6) {
+      case 0: bad.position_rev = nan; break;
+      case 1: bad.load_cell_kN = std::numeric_limits<double>::infinity(); break;
+      case 2: bad.load_cell_kN = 1e4; break;
+      case 3: bad.load_cell_kN += 5.0; break;  // the same sequence number again
+      case 4:
+        bad.seq = r.seq > 3 ? r.seq - 3 : 0;  // backwards
+        bad.load_cell_kN = 0.0;
+        break;
+      case 5: bad.motor_current_A = nan; break;
+    }
+    out.push_back(bad);
+    ++added;
+  };
+  const auto dirty = run_closed_loop(fs, o);
+  ASSERT_EQ(clean.periods.size(), dirty.periods.size());
+  for (std::size_t k = 0; k < clean.periods.size(); ++k) {
+    for (std::size_t i = 0; i < kCorners; ++i) {
+      ASSERT_EQ(clean.periods[k].command_kN[i], dirty.periods[k].command_kN[i]) << k;
+      ASSERT_EQ(clean.periods[k].true_kN[i], dirty.periods[k].true_kN[i]) << k;
+      const double a = clean.periods[k].estimate_kN[i], b = dirty.periods[k].estimate_kN[i];
+      ASSERT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << k;
+    }
+  }
+  std::uint64_t rejected = 0;
+  for (std::size_t i = 0; i < kCorners; ++i) {
+    rejected += dirty.guard_rejected[i];
+    EXPECT_EQ(dirty.calibrator_samples[i], clean.calibrator_samples[i]);
+  }
+  EXPECT_GT(added, 1000u);
+  EXPECT_EQ(rejected, added);
+  EXPECT_EQ(dirty.faults_raised(), 0u);
+}
+
+TEST(ClosedLoop, ACcuKillLeavesEveryCornerBrakingAtHeldThenDefaultForce) {
+  const auto fs = load("config/scenarios/faults/ccu_kill.yaml");
+  const auto o = default_options();
+  const auto r = run_closed_loop(fs, o);
+  const double default_kN = o.watchdog.default_clamp_force_kN;
+  for (const auto& p : r.periods) {
+    if (p.time_s < kFaultAt + 0.01) continue;
+    ASSERT_FALSE(p.ccu_alive);
+    for (std::size_t i = 0; i < kCorners; ++i) {
+      ASSERT_GE(p.applied_kN[i], default_kN - 1e-9) << p.time_s;  // the stop held 13..20 kN > default
+      if (p.time_s > kFaultAt + o.watchdog.timeout_s + o.watchdog.hold_s + 0.6) {
+        ASSERT_NEAR(p.applied_kN[i], default_kN, 1e-9) << p.time_s;
+        ASSERT_NEAR(p.true_kN[i], default_kN, 1.5) << p.time_s;  // still braking after the pedal release
+      }
+    }
+  }
+}
+
+TEST(ClosedLoop, ARestartedCornerRejoinsWithItsLastGoodCurveAndNoSampleTwice) {
+  const auto fs = load("config/scenarios/faults/process_kill.yaml");
+  std::vector<std::uint64_t> seen_rr;
+  auto o = default_options();
+  o.deliver = [&](std::size_t corner, const CornerReading& r, std::vector<CornerReading>& out) {
+    if (corner == 3) seen_rr.push_back(r.seq);
+    out.push_back(r);
+  };
+  const auto r = run_closed_loop(fs, o);
+  EXPECT_EQ(r.calibrator_restarts[3], 1u);
+  EXPECT_EQ(r.guard_rejected[3], 0u);
+  // 11000 samples before the kill at 11 s, then a new incarnation from 1 after the restart.
+  ASSERT_GT(seen_rr.size(), 11000u);
+  EXPECT_EQ(seen_rr[10999], 11000u);
+  EXPECT_EQ(seen_rr[11000], 1u);
+  EXPECT_EQ(seen_rr.size(), 11000u + 2500u);
+  bool back = false;
+  for (const auto& p : r.periods) {
+    if (p.time_s > kFaultAt + 0.03 && p.time_s < kFaultAt + 0.5) {
+      ASSERT_FALSE(p.available[3]) << p.time_s;
+    }
+    if (p.time_s > kFaultAt + 0.6 && p.time_s < kStopEnd) {
+      back = back || p.available[3];
+      ASSERT_LT(std::abs(p.estimate_kN[3] - p.true_kN[3]), 0.5) << p.time_s;
+    }
+  }
+  EXPECT_TRUE(back);
+  EXPECT_GT(recovery_time_s(r, 0.9, kFaultAt + 0.6, kStopEnd, 160.0), 0.0);
 }

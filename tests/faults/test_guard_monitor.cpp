@@ -1,1 +1,231 @@
+// The sample guard, the fault monitor's rules on synthetic readings, and the last good state.
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "bbw/faults/fault_monitor.hpp"
+#include "bbw/faults/last_good.hpp"
+#include "bbw/faults/sample_guard.hpp"
+#include "closed_loop.hpp"
+
+using namespace bbw::faults;
+
+namespace {
+
+CornerReading at(std::uint64_t seq, double t, double x = 2.0, double lc = 5.0) {
+  CornerReading r;
+  r.seq = seq;
+  r.time_s = t;
+  r.position_rev = x;
+  r.load_cell_kN = lc;
+  r.motor_current_A = 1.0;
+  return r;
+}
+
+bbw::calibration::Estimate estimate(double force_kN, double curve_kN) {
+  bbw::calibration::Estimate e;
+  e.valid = true;
+  e.calibrated = true;
+  e.force_kN = force_kN;
+  e.curve_force_kN = curve_kN;
+  return e;
+}
+
+}  // namespace
+
+TEST(SampleGuard, ClassifiesAndCountsEveryKindOfCorruptSample) {
+  SampleGuard g(GuardLimits{});
+  EXPECT_TRUE(g.check(at(1, 0.001)).usable());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  auto r = at(2, 0.002);
+  r.position_rev = nan;
+  EXPECT_EQ(g.check(r).issue, SampleIssue::NonFinite);
+  r = at(2, 0.002, 2.0, inf);
+  EXPECT_EQ(g.check(r).issue, SampleIssue::NonFinite);
+  r = at(2, 0.002, 2.0, 500.0);
+  EXPECT_EQ(g.check(r).issue, SampleIssue::OutOfRange);
+  r = at(2, 0.002, 42.0);
+  EXPECT_EQ(g.check(r).issue, SampleIssue::OutOfRange);
+  EXPECT_EQ(g.check(at(1, 0.002)).issue, SampleIssue::Duplicate);
+  EXPECT_EQ(g.check(at(0, 0.002)).issue, SampleIssue::SequenceBackwards);
+  EXPECT_EQ(g.check(at(2, 0.001)).issue, SampleIssue::TimeBackwards);
+  // A dropout: usable, without its load cell.
+  const auto c = g.check(at(2, 0.002, 2.0, nan));
+  EXPECT_TRUE(c.usable());
+  EXPECT_FALSE(c.load_cell_present);
+  EXPECT_EQ(g.load_cell_missing(), 1u);
+  EXPECT_EQ(g.rejected(), 7u);
+  EXPECT_EQ(g.count(SampleIssue::NonFinite), 2u);
+  // A restarted corner counts from 1 again; its time must still move forward.
+  g.rejoin();
+  EXPECT_EQ(g.check(at(1, 0.001)).issue, SampleIssue::TimeBackwards);
+  EXPECT_TRUE(g.check(at(1, 0.003)).usable());
+  EXPECT_EQ(g.check(at(1, 0.004)).issue, SampleIssue::Duplicate);
+}
+
+TEST(FaultMonitor, DefaultParametersAreValidAndInvalidOnesNameTheField) {
+  EXPECT_NO_THROW(MonitorParams{}.validate());
+  MonitorParams p;
+  p.uncalibrated_residual_threshold_kN = 0.1;
+  try {
+    p.validate();
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("uncalibrated_residual_threshold_kN"), std::string::npos);
+  }
+  EXPECT_THROW(FaultMonitor(MonitorParams{}, Target::CCU), std::invalid_argument);
+}
+
+TEST(FaultMonitor, AResidualMustPersistAndIsIsolatedToTheLoadCellWithoutAResolverJump) {
+  MonitorParams p;
+  FaultMonitor m(p, Target::FR);
+  SampleGuard g(p.guard);
+  std::uint64_t seq = 0;
+  double t = 0.0;
+  auto feed = [&](double residual_kN, double x) {
+    ++seq;
+    t += 0.001;
+    auto r = at(seq, t, x, 10.0 + residual_kN);
+    const auto e = estimate(10.0 + residual_kN, 10.0);
+    m.update(r, g.check(r), &e, e.force_kN, t);
+  };
+  for (int k = 0; k < 100; ++k) feed(0.1, 3.0);
+  // A short excursion (shorter than residual_persist_s) is not a fault.
+  for (int k = 0; k < 15; ++k) feed(1.0, 3.0);
+  for (int k = 0; k < 50; ++k) feed(0.1, 3.0);
+  EXPECT_TRUE(m.ok(Part::LoadCell));
+  const double onset = t + 0.001;
+  for (int k = 0; k < 40; ++k) feed(1.0, 3.0);
+  const auto& d = m.diagnosis(Part::LoadCell);
+  ASSERT_TRUE(d.present);
+  EXPECT_EQ(d.finding, Finding::LoadCellOffset);
+  EXPECT_NEAR(d.onset_s, onset, 1e-9);
+  EXPECT_NEAR(d.detected_s - d.onset_s, p.residual_persist_s, 1.5e-3);
+  EXPECT_TRUE(m.ok(Part::Resolver));
+}
+
+TEST(FaultMonitor, OutsideTheFittedRangeTheResidualIsNotJudged) {
+  MonitorParams p;
+  FaultMonitor m(p, Target::FR);
+  m.set_curve_range(2.0, 4.0);
+  SampleGuard g(p.guard);
+  for (int k = 1; k < 200; ++k) {
+    auto r = at(static_cast<std::uint64_t>(k), 0.001 * k, 5.0, 20.0);
+    const auto e = estimate(20.0, 17.0);
+    m.update(r, g.check(r), &e, e.force_kN, r.time_s);
+  }
+  EXPECT_TRUE(m.ok(Part::LoadCell));
+  EXPECT_TRUE(std::isnan(m.last_residual_kN()));
+}
+
+TEST(FaultMonitor, AResolverJumpIsAnOffsetUnlessItIsUndone) {
+  MonitorParams p;
+  SampleGuard g(p.guard);
+  FaultMonitor glitch(p, Target::FL), offset(p, Target::FL);
+  for (int k = 1; k < 100; ++k) {
+    const double t = 0.001 * k;
+    const double x_glitch = k == 50 ? 2.1 : 2.0;
+    const double x_offset = k >= 50 ? 2.1 : 2.0;
+    auto a = at(static_cast<std::uint64_t>(k), t, x_glitch);
+    a.speed_rev_per_s = 0.0;
+    auto b = at(static_cast<std::uint64_t>(k), t, x_offset);
+    b.speed_rev_per_s = 0.0;
+    SampleCheck ok;
+    glitch.update(a, ok, nullptr, 5.0, t);
+    offset.update(b, ok, nullptr, 5.0, t);
+  }
+  EXPECT_TRUE(glitch.ok(Part::Resolver));
+  ASSERT_FALSE(offset.ok(Part::Resolver));
+  EXPECT_EQ(offset.diagnosis(Part::Resolver).finding, Finding::ResolverOffset);
+  EXPECT_NEAR(offset.diagnosis(Part::Resolver).onset_s, 0.050, 1e-9);
+}
+
+TEST(FaultMonitor, StuckChannelsNeedTheOtherChannelToMove) {
+  MonitorParams p;
+  SampleCheck ok;
+  FaultMonitor parked(p, Target::RL), moving(p, Target::RL), resolver(p, Target::RL);
+  for (int k = 1; k < 100; ++k) {
+    const double t = 0.001 * k;
+    parked.update(at(k, t, 2.0, 7.0), ok, nullptr, 7.0, t);               // nothing moves: no finding
+    moving.update(at(k, t, 2.0 + 0.01 * k, 7.0), ok, nullptr, 7.0, t);    // load cell frozen, position moves
+    resolver.update(at(k, t, 2.0, 7.0 + 0.1 * k), ok, nullptr, 7.0, t);   // position frozen, load moves
+  }
+  EXPECT_EQ(parked.diagnosis(Part::LoadCell).present || parked.diagnosis(Part::Resolver).present, false);
+  EXPECT_EQ(moving.diagnosis(Part::LoadCell).finding, Finding::LoadCellStuck);
+  EXPECT_EQ(resolver.diagnosis(Part::Resolver).finding, Finding::ResolverStuck);
+}
+
+TEST(FaultMonitor, DropoutNeedsConsecutiveMissingValues) {
+  MonitorParams p;
+  FaultMonitor m(p, Target::FL);
+  SampleCheck missing;
+  missing.load_cell_present = false;
+  SampleCheck ok;
+  for (int k = 1; k < 60; ++k) {
+    const bool gap = (k % 5 == 0) || (k >= 40 && k < 40 + p.dropout_samples);
+    m.update(at(k, 0.001 * k), gap ? missing : ok, nullptr, 5.0, 0.001 * k);
+    if (k < 40 + p.dropout_samples - 1) ASSERT_TRUE(m.ok(Part::LoadCell)) << k;
+  }
+  EXPECT_EQ(m.diagnosis(Part::LoadCell).finding, Finding::LoadCellMissing);
+  EXPECT_NEAR(m.diagnosis(Part::LoadCell).onset_s, 0.040, 1e-9);
+}
+
+TEST(FaultMonitor, DeadlineLivelinessAndRejoin) {
+  MonitorParams p;
+  FaultMonitor m(p, Target::RR);
+  SampleCheck ok;
+  m.update(at(1, 0.001), ok, nullptr, 5.0, 0.001);
+  m.tick(0.001 + p.deadline_s * 0.9);
+  EXPECT_TRUE(m.ok(Part::Network));
+  m.tick(0.001 + p.deadline_s * 1.1);
+  EXPECT_EQ(m.diagnosis(Part::Network).finding, Finding::LinkLost);
+  m.on_link_event(LinkEvent::LivelinessLost, 0.03);
+  EXPECT_TRUE(m.ok(Part::Network));  // the process is named instead of the link
+  EXPECT_EQ(m.diagnosis(Part::Process).finding, Finding::ProcessLost);
+  EXPECT_NEAR(m.diagnosis(Part::Process).onset_s, 0.001, 1e-12);
+  EXPECT_TRUE(m.process_was_lost());
+  m.update(at(1, 0.5), ok, nullptr, 5.0, 0.5);
+  EXPECT_TRUE(m.ok(Part::Process));
+  EXPECT_TRUE(m.diagnosis(Part::Process).present);
+  EXPECT_TRUE(m.take_rejoin());
+  EXPECT_FALSE(m.take_rejoin());
+}
+
+TEST(FaultMonitor, TorqueBalanceSeparatesPartialAndTotalLoss) {
+  MonitorParams p;
+  SampleCheck ok;
+  auto run = [&](double fraction) {
+    FaultMonitor m(p, Target::FL);
+    for (int k = 1; k < 200; ++k) {
+      auto r = at(k, 0.001 * k, 4.0, 20.0);
+      r.speed_rev_per_s = 0.0;
+      r.motor_current_A = 20.0 * p.Nm_per_kN / (p.torque_per_A_Nm * fraction);
+      m.update(r, ok, nullptr, 20.0, r.time_s);
+    }
+    return m.diagnosis(Part::Actuator);
+  };
+  EXPECT_FALSE(run(0.9).present);
+  EXPECT_EQ(run(0.4).finding, Finding::ActuatorTorqueLoss);
+  EXPECT_EQ(run(0.1).finding, Finding::ActuatorLost);
+}
+
+TEST(LastGoodCalibration, GivesTheNewestSnapshotBeforeATime) {
+  const auto cfg = test::default_options().calibrator;
+  bbw::calibration::Calibrator c(cfg);
+  LastGoodCalibration g(c);
+  EXPECT_FALSE(g.before(10.0).from_fit);
+  EXPECT_DOUBLE_EQ(g.before(10.0).curve.d, cfg.initial_curve.d);
+  for (int k = 1; k <= 6; ++k) {
+    bbw::calibration::Curve curve = cfg.initial_curve;
+    curve.d = k;
+    c.reset_curve(curve);
+    g.push(k, c);
+  }
+  EXPECT_EQ(g.size(), LastGoodCalibration::kCapacity);
+  EXPECT_DOUBLE_EQ(g.before(4.5).curve.d, 4.0);
+  EXPECT_DOUBLE_EQ(g.before(4.0).curve.d, 3.0);
+  EXPECT_DOUBLE_EQ(g.newest().curve.d, 6.0);
+  EXPECT_FALSE(g.before(2.5).from_fit);  // older than the ring holds: the initial state
+}

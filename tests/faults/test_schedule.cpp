@@ -1,1 +1,150 @@
+// The fault schedule: strict YAML through the scenario's ExtraKeys hook, every campaign file.
 #include <gtest/gtest.h>
+
+#include <filesystem>
+#include <set>
+
+#include "bbw/faults/schedule_yaml.hpp"
+#include "bbw/faults/link_faults.hpp"
+#include "closed_loop.hpp"
+
+using namespace bbw::faults;
+using bbw::config::ConfigError;
+
+namespace {
+
+const char* kBase = R"(name: t
+seed: 1
+duration_s: 2.0
+plant: ../../plant/ecaliper.yaml
+demand: {max_clamp_force_kN: 40, front_share: 0.6, profile: [[0, 0], [1, 0.5]]}
+corners:
+  - {name: FL, temperature_C: 30, drive: {mode: demand, feedback: load_cell}}
+  - {name: RR, temperature_C: 30, drive: {mode: demand, feedback: load_cell}}
+)";
+
+FaultScenario parse(const std::string& faults) {
+  return load_fault_scenario_string(std::string(kBase) + faults, test::source_path("config/scenarios/faults/inline.yaml"));
+}
+
+std::string key_of_error(const std::string& faults) {
+  try {
+    parse(faults);
+  } catch (const ConfigError& e) {
+    return e.key_path() + " | " + e.rule();
+  }
+  return "no error";
+}
+
+}  // namespace
+
+TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
+  std::set<FaultType> types;
+  std::size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(test::source_path("config/scenarios/faults"))) {
+    if (entry.path().extension() != ".yaml") continue;
+    ++files;
+    const auto fs = load_fault_scenario(entry.path().string());
+    if (fs.scenario.name == "fault_free_stop") {
+      EXPECT_TRUE(fs.faults.empty());
+    } else {
+      ASSERT_EQ(fs.faults.faults.size(), 1u) << entry.path();
+      types.insert(fs.faults.faults[0].type);
+    }
+  }
+  EXPECT_EQ(files, 14u);
+  EXPECT_EQ(types.size(), 11u);  // every FaultType; stuck appears for both sensors
+}
+
+TEST(FaultSchedule, ReadsEachTypeWithItsParameters) {
+  const auto fs = parse(R"(faults:
+  - {at_s: 0.5, corner: FL, part: load_cell, type: bias, bias_kN: -1.5, duration_s: 0.2}
+  - {at_s: 0.5, corner: RR, part: actuator, type: torque_loss, loss_percent: 40}
+  - {at_s: 0.6, corner: RR, part: network, type: delay, delay_ms: 12}
+  - {at_s: 0.7, corner: FL, part: process, type: kill, restart_after_s: 0.3}
+  - {at_s: 0.8, corner: CCU, part: process, type: kill}
+)");
+  ASSERT_EQ(fs.faults.faults.size(), 5u);
+  const auto& b = fs.faults.faults[0];
+  EXPECT_EQ(b.type, FaultType::Bias);
+  EXPECT_DOUBLE_EQ(b.bias_kN, -1.5);
+  EXPECT_DOUBLE_EQ(b.end_s(), 0.7);
+  EXPECT_TRUE(b.active_at(0.5));
+  EXPECT_FALSE(b.active_at(0.7));
+  EXPECT_GT(b.line, 0);
+  EXPECT_DOUBLE_EQ(fs.faults.faults[1].torque_loss_percent, 40.0);
+  EXPECT_DOUBLE_EQ(fs.faults.faults[2].delay_ms, 12.0);
+  EXPECT_FALSE(fs.faults.faults[2].duration_s.has_value());
+  EXPECT_DOUBLE_EQ(fs.faults.faults[3].end_s(), 1.0);
+  EXPECT_TRUE(std::isinf(fs.faults.faults[4].end_s()));
+  EXPECT_EQ(fs.faults.for_target(Target::RR).size(), 2u);
+}
+
+TEST(FaultSchedule, RejectsWhatIsWrongNamingKeyAndRule) {
+  EXPECT_EQ(key_of_error("faults:\n  - {at_s: 0.5, corner: FL, part: resolver, type: bias, bias_kN: 1}\n").substr(0, 15),
+            "faults[0].type ");
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: FL, part: load_cell, type: bias}\n").find("faults[0].bias_kN"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: FL, part: load_cell, type: bias, bias_kN: 0}\n").find("must not be 0"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: FL, part: load_cell, type: stuck, extra: 1}\n").find("faults[0].extra"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: CCU, part: network, type: silence, duration_s: 1}\n").find("faults[0].part"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: FL, part: network, type: silence}\n").find("faults[0].duration_s"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: FL, part: process, type: kill, duration_s: 1}\n").find("restart_after_s"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: FL, part: actuator, type: torque_loss, loss_percent: 100}\n").find("loss_percent"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: FR, part: load_cell, type: stuck}\n").find("no corner named FR"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 2.5, corner: FL, part: load_cell, type: stuck}\n").find("faults[0].at_s"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: -1, corner: FL, part: load_cell, type: stuck}\n").find("faults[0].at_s"),
+            std::string::npos);
+}
+
+TEST(FaultSchedule, WithoutTheHookAFaultListIsAnUnknownKey) {
+  EXPECT_THROW(bbw::scenario::load_scenario(test::source_path("config/scenarios/faults/load_cell_bias.yaml")), ConfigError);
+  EXPECT_NO_THROW(load_fault_scenario(test::source_path("config/scenarios/faults/load_cell_bias.yaml")));
+}
+
+TEST(FaultSchedule, LinkFaultsAnswerInTimeAndProcessActionsAreOrdered) {
+  const auto fs = parse(R"(faults:
+  - {at_s: 0.5, corner: RR, part: network, type: silence, duration_s: 0.2}
+  - {at_s: 0.6, corner: RR, part: network, type: delay, delay_ms: 30, duration_s: 0.5}
+  - {at_s: 0.9, corner: FL, part: process, type: kill, restart_after_s: 0.3}
+  - {at_s: 0.2, corner: CCU, part: process, type: kill}
+)");
+  const LinkFaults rr(fs.faults, Target::RR);
+  EXPECT_FALSE(rr.silenced(0.49));
+  EXPECT_TRUE(rr.silenced(0.5));
+  EXPECT_FALSE(rr.silenced(0.7));
+  EXPECT_DOUBLE_EQ(rr.delay_s(0.55), 0.0);
+  EXPECT_DOUBLE_EQ(rr.delay_s(0.65), 0.03);
+  EXPECT_TRUE(rr.sends(0.8));
+  const LinkFaults fl(fs.faults, Target::FL);
+  EXPECT_TRUE(fl.killed(1.0));
+  EXPECT_FALSE(fl.killed(1.2));
+  const auto acts = process_actions(fs.faults);
+  ASSERT_EQ(acts.size(), 3u);
+  EXPECT_EQ(acts[0].target, Target::CCU);
+  EXPECT_EQ(acts[1].kind, ProcessAction::Kind::Kill);
+  EXPECT_EQ(acts[2].kind, ProcessAction::Kind::Restart);
+  EXPECT_DOUBLE_EQ(acts[2].at_s, 1.2);
+}
+
+TEST(DelayQueue, ReleasesInOrderWhenDueAndRefusesWhenFull) {
+  DelayQueue<int, 3> q;
+  EXPECT_TRUE(q.push(0.03, 1));
+  EXPECT_TRUE(q.push(0.01, 2));  // a shrinking delay does not overtake
+  EXPECT_TRUE(q.push(0.05, 3));
+  EXPECT_FALSE(q.push(0.06, 4));
+  EXPECT_FALSE(q.pop_due(0.02).has_value());
+  EXPECT_EQ(*q.pop_due(0.03), 1);
+  EXPECT_EQ(*q.pop_due(0.03), 2);
+  EXPECT_FALSE(q.pop_due(0.04).has_value());
+  EXPECT_EQ(*q.pop_due(0.05), 3);
+  EXPECT_EQ(q.size(), 0u);
+}

@@ -25,6 +25,8 @@ void MonitorParams::validate() const {
               uncalibrated_residual_threshold_kN >= residual_threshold_kN,
           "uncalibrated_residual_threshold_kN", uncalibrated_residual_threshold_kN, "must be >= residual_threshold_kN");
   positive("residual_persist_s", residual_persist_s);
+  positive("residual_reference_s", residual_reference_s);
+  positive("residual_change_threshold_kN", residual_change_threshold_kN);
   require(std::isfinite(curve_min_rev), "curve_min_rev", curve_min_rev, "must be finite");
   require(std::isfinite(curve_max_rev) && curve_max_rev > curve_min_rev, "curve_max_rev", curve_max_rev,
           "must be finite and > curve_min_rev");
@@ -256,13 +258,26 @@ void FaultMonitor::check_residual(const CornerReading& r, const calibration::Est
   if (r.position_rev < curve_min_rev_ || r.position_rev > curve_max_rev_) {
     residual_suspect_ = false;  // no trusted curve here
     residual_kN_ = std::numeric_limits<double>::quiet_NaN();
+    residual_change_kN_ = std::numeric_limits<double>::quiet_NaN();
+    have_reference_ = false;  // restarts where the curve is trusted again
     return;
   }
+  if (!have_reference_) {
+    have_reference_ = true;
+    reference_kN_ = residual_kN_;
+    reference_time_s_ = t;
+  }
+  residual_change_kN_ = residual_kN_ - reference_kN_;
   const double thr = e.calibrated ? p_.residual_threshold_kN : p_.uncalibrated_residual_threshold_kN;
-  if (std::abs(residual_kN_) <= thr) {
+  const bool over = std::abs(residual_kN_) > thr || (e.calibrated && std::abs(residual_change_kN_) > p_.residual_change_threshold_kN);
+  if (!over) {
     residual_suspect_ = false;
+    const double dt = std::max(0.0, t - reference_time_s_);
+    reference_kN_ += (residual_kN_ - reference_kN_) * -std::expm1(-dt / p_.residual_reference_s);
+    reference_time_s_ = t;
     return;
   }
+  reference_time_s_ = t;  // frozen while suspected
   if (!residual_suspect_) {
     residual_suspect_ = true;
     residual_onset_s_ = t;

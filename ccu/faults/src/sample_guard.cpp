@@ -46,7 +46,7 @@ std::uint64_t SampleGuard::rejected() const {
   return n;
 }
 
-void SampleGuard::rejoin() { have_last_ = false; }
+void SampleGuard::rejoin() { seq_continuity_ = false; }
 
 SampleCheck SampleGuard::check(const CornerReading& r) {
   SampleCheck c;
@@ -60,9 +60,9 @@ SampleCheck SampleGuard::check(const CornerReading& r) {
              std::abs(r.motor_current_A) > limits_.current_abs_max_A ||
              (!lc_nan && (r.load_cell_kN < limits_.load_cell_min_kN || r.load_cell_kN > limits_.load_cell_max_kN))) {
     c.issue = SampleIssue::OutOfRange;
-  } else if (have_last_ && r.seq == last_seq_) {
+  } else if (have_last_ && seq_continuity_ && r.seq == last_seq_) {
     c.issue = SampleIssue::Duplicate;
-  } else if (have_last_ && r.seq < last_seq_) {
+  } else if (have_last_ && seq_continuity_ && r.seq < last_seq_) {
     c.issue = SampleIssue::SequenceBackwards;
   } else if (have_last_ && !(r.time_s > last_time_s_)) {
     c.issue = SampleIssue::TimeBackwards;
@@ -73,6 +73,7 @@ SampleCheck SampleGuard::check(const CornerReading& r) {
     return c;
   }
   have_last_ = true;
+  seq_continuity_ = true;
   last_seq_ = r.seq;
   last_time_s_ = r.time_s;
   c.load_cell_present = !lc_nan;

@@ -27,6 +27,12 @@ struct MonitorParams {
   double residual_threshold_kN = 0.6;               // once the calibrator has an accepted fit
   double uncalibrated_residual_threshold_kN = 3.0;  // before it (initial curve, no friction model)
   double residual_persist_s = 0.02;
+  // A change of the residual against its own recent level (a low-pass with this time constant,
+  // frozen while a fault is suspected) beyond residual_change_threshold_kN is also a
+  // disagreement (once calibrated): it catches a step whose sign the standing calibration error
+  // partly cancels, or that the local loop's reaction partly hides.
+  double residual_reference_s = 0.5;
+  double residual_change_threshold_kN = 0.45;
   // Where the curve is trusted: the calibrator's range (CornerSupervisor copies x_min_rev and
   // x_max_rev of the calibrator config here). Outside it the cubic is an extrapolation.
   double curve_min_rev = 1.0;
@@ -133,6 +139,8 @@ class FaultMonitor {
   void set_curve_range(double min_rev, double max_rev);
   // The last residual inside the curve's range (NaN outside it or before the first).
   double last_residual_kN() const { return residual_kN_; }
+  // The last residual minus its reference level (NaN where the residual is).
+  double last_residual_change_kN() const { return residual_change_kN_; }
   // Share of large residual steps in the noise window.
   double last_noise_fraction() const { return noise_kN_; }
   Target corner() const { return corner_; }
@@ -157,6 +165,10 @@ class FaultMonitor {
   bool residual_suspect_ = false;
   double residual_onset_s_ = 0.0;
   double residual_kN_ = std::numeric_limits<double>::quiet_NaN();
+  double residual_change_kN_ = std::numeric_limits<double>::quiet_NaN();
+  bool have_reference_ = false;
+  double reference_kN_ = 0.0;
+  double reference_time_s_ = 0.0;
   bool have_prev_residual_ = false;
   double prev_residual_kN_ = 0.0;
   // resolver jumps

@@ -44,7 +44,8 @@ class SampleGuard {
   explicit SampleGuard(const GuardLimits& limits);  // throws std::invalid_argument
 
   SampleCheck check(const CornerReading& r);
-  // A new incarnation of the corner (a restarted process): its sequence may start again.
+  // A new incarnation of the corner (a restarted process): its sequence may start again;
+  // its time must still move forward (the scenario's time base continues).
   void rejoin();
 
   std::uint64_t count(SampleIssue i) const { return counts_[static_cast<std::size_t>(i)]; }
@@ -57,6 +58,7 @@ class SampleGuard {
  private:
   GuardLimits limits_;
   bool have_last_ = false;
+  bool seq_continuity_ = true;  // false after rejoin() until the next accepted sample
   std::uint64_t last_seq_ = 0;
   double last_time_s_ = 0.0;
   std::array<std::uint64_t, kSampleIssueCount> counts_{};
