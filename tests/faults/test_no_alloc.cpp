@@ -1,0 +1,70 @@
+// Per-sample fault code allocates nothing after construction: the injector on a CornerSim, the
+// corner watchdog, and the CCU's CornerSupervisor (guard, calibrator, monitor, reactions) and
+// Redistributor, over a run with a load-cell fault being detected and reacted to.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "bbw/faults/ccu_watchdog.hpp"
+#include "bbw/faults/corner_supervisor.hpp"
+#include "bbw/faults/injector.hpp"
+#include "bbw/faults/redistributor.hpp"
+#include "closed_loop.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}
+
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+using namespace bbw::faults;
+
+TEST(FaultAllocation, NoHeapAllocationPerSample) {
+  auto fs = load_fault_scenario(test::source_path("config/scenarios/faults/load_cell_bias.yaml"));
+  // A constant command gives the calibrator no cycles: use a bias above the uncalibrated threshold.
+  fs.faults.faults.at(0).bias_kN = 4.0;
+  const auto options = test::default_options();
+  bbw::scenario::CornerSim sim(fs.scenario, 0);
+  FaultInjector injector(fs.faults, Target::FL, 5);
+  CcuWatchdog watchdog(options.watchdog);
+  CornerSupervisor sup(options.calibrator, options.monitor, Target::FL);
+  const Redistributor redistributor(0.6);
+  std::array<CornerCapacity, kCorners> cap{};
+  const long before = g_allocations.load();
+  double sum = 0.0;
+  for (int k = 0; k < 14000; ++k) {
+    const double t = sim.time_s() + 0.001;
+    watchdog.on_command(t, 20.0);
+    bbw::scenario::ExternalInputs ext;
+    ext.force_command_kN = watchdog.at(t).force_command_kN;
+    ext.feedback = sup.view().feedback;
+    injector.prepare(ext, t);
+    const auto& s = sim.step(0.001, ext);
+    CornerReading r;
+    r.seq = s.seq;
+    r.time_s = s.time_s;
+    r.position_rev = s.position_rev;
+    r.speed_rev_per_s = s.speed_rev_s;
+    r.load_cell_kN = s.force_internal_kN;
+    r.motor_current_A = s.motor_current_A;
+    r.force_command_kN = s.command;
+    const CornerView& v = sup.on_sample(r, t);
+    sup.tick(t);
+    cap[0] = {v.available, v.force_limit_kN};
+    sum += redistributor.allocate(66.0, cap).total_kN;
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_GT(sum, 0.0);
+  EXPECT_FALSE(sup.monitor().ok(Part::LoadCell));  // the bias at 11 s was found and reacted to
+}
