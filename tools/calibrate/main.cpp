@@ -1,7 +1,6 @@
 // bbw_calibrate: the calibrator offline over a CSV recording (./bbw calibrate).
-#include <sys/stat.h>
-
 #include <cstdio>
+#include <filesystem>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -104,9 +103,9 @@ int main(int argc, char** argv) {
     if (!speed_col.empty()) rec.speed_rev_s = table.column(speed_col);
     const auto res = bbw::calibration::run_recording(config, rec);
 
-    ::mkdir(a.out.c_str(), 0755);
-    struct stat st {};
-    if (::stat(a.out.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) throw std::runtime_error(a.out + ": cannot create output directory");
+    std::error_code ec;
+    std::filesystem::create_directories(a.out, ec);
+    if (!std::filesystem::is_directory(a.out)) throw std::runtime_error(a.out + ": cannot create output directory");
     const bool has_truth = !rec.truth_kN.empty();
     {
       bbw::csv::Writer w(a.out + "/estimates.csv",
