@@ -245,11 +245,17 @@ TEST_F(SecureDds, AccessControlRefusesWritersThePermissionsDoNotGrant) {
   // What is granted still works on the same participants.
   PartitionWriter<HealthT> health(fl, bbw::dds::kHealthTopic, "state_writer", bbw::security::corner_partition("FL"),
                                   events);
+  // The CCU reads each corner in that corner's own partition (so it knows who wrote a sample);
+  // its grant "corner_*" covers every one of them.
   PartitionReader<HealthT> ccu_health(ccu, bbw::dds::kHealthTopic, "state_reader",
-                                      bbw::security::kCornerPartitionPattern, events);
+                                      bbw::security::corner_partition("FL"), events);
+  PartitionReader<HealthT> ccu_health_rr(ccu, bbw::dds::kHealthTopic, "state_reader",
+                                         bbw::security::corner_partition("RR"), events);
   ASSERT_TRUE(health.created());
   ASSERT_TRUE(ccu_health.created());
+  ASSERT_TRUE(ccu_health_rr.created());
   ASSERT_TRUE(events.wait_for(kMatchTimeout, [&] { return health.matched() == 1 && ccu_health.matched() == 1; }));
+  EXPECT_EQ(ccu_health_rr.matched(), 0) << "a reader in partition corner_RR matched corner FL's writer";
   bbw::msg::CornerHealth h;
   h.corner_id(0);
   h.status(1);
