@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "bbw/calibration/config_yaml.hpp"
+#include "bbw/calibration/fusion.hpp"
 #include "rig_recording.hpp"
 
 using namespace bbw::calibration;
@@ -116,4 +117,55 @@ TEST(CalibratorAccuracy, ViscousTermFoundOfflineLowersOnlineErrorWhenSwitchedOn)
   const auto clean_off = run_recording(off, clean);
   EXPECT_LT(clean_on.friction.viscous_kN_per_rev_per_s, 0.03);  // measured 0.019: some model mismatch leaks in
   EXPECT_LT(clean_on.score.max_abs_error_kN, clean_off.score.max_abs_error_kN + 0.03);
+}
+
+TEST(EstimateFusion, TrustsTheCurveOnlyAsFarAsItAgreesWithTheCompensatedLoadCell) {
+  // Four-corner rig at 54 C starting from the 40 C curve: early on the curve is off by kN, so a
+  // fixed 50/50 blend is worse than f_hat; the learned weighting is never worse than f_hat by
+  // more than a little and is better than the fixed blend.
+  const auto sc = bbw::scenario::load_scenario(source_path("config/scenarios/paper_rig_sweep.yaml"));
+  const auto cfg = load_config(source_path("config/calibrator/robust.yaml"));
+  const auto rec = record_corner(sc, sc.corners.size() - 1);
+  Calibrator cal(cfg);
+  EstimateFusion fusion(FusionParams{});
+  double max_fhat = 0.0, max_fused = 0.0, max_blend = 0.0, sse_fhat = 0.0, sse_fused = 0.0;
+  for (std::size_t k = 0; k < rec.time_s.size(); ++k) {
+    const auto e = cal.update({rec.time_s[k], rec.position_rev[k], rec.force_kN[k]});
+    const double fused = fusion.update(e, 0.001);
+    if (!e.calibrated) continue;
+    const double t = rec.truth_kN[k];
+    max_fhat = std::max(max_fhat, std::fabs(e.force_kN - t));
+    max_fused = std::max(max_fused, std::fabs(fused - t));
+    max_blend = std::max(max_blend, std::fabs(0.5 * (e.force_kN + e.curve_force_kN) - t));
+    sse_fhat += (e.force_kN - t) * (e.force_kN - t);
+    sse_fused += (fused - t) * (fused - t);
+  }
+  std::printf("max error: f_hat %.3f, fused %.3f, fixed 50/50 %.3f kN; final curve weight %.3f, curve rms %.3f kN\n",
+              max_fhat, max_fused, max_blend, fusion.curve_weight(), fusion.curve_rms_error_kN());
+  EXPECT_LT(max_fused, max_fhat + 0.03);
+  EXPECT_LT(max_fused, 0.5 * max_blend);
+  EXPECT_LE(sse_fused, sse_fhat * 1.02);
+  EXPECT_GT(fusion.curve_weight(), 0.0);
+  EXPECT_LT(fusion.curve_weight(), 0.5);
+}
+
+TEST(EstimateFusion, PassesThroughBeforeCalibrationAndRejectsBadParams) {
+  EstimateFusion f(FusionParams{});
+  Estimate e;
+  e.valid = true;
+  e.calibrated = false;
+  e.force_kN = 3.0;
+  e.curve_force_kN = 10.0;
+  EXPECT_DOUBLE_EQ(f.update(e, 0.001), 3.0);
+  e.calibrated = true;
+  // A curve whose own error is as large as the load cell's (disagreement variance 2 sigma^2)
+  // gets half the weight.
+  for (int k = 0; k < 20000; ++k) {
+    e.curve_force_kN = e.force_kN + ((k % 2) ? 0.03 : -0.03) * std::sqrt(2.0);
+    f.update(e, 0.001);
+  }
+  EXPECT_NEAR(f.curve_weight(), 0.5, 0.1);
+  FusionParams bad;
+  bad.load_cell_noise_kN = 0.0;
+  EXPECT_THROW(EstimateFusion{bad}, std::invalid_argument);
 }
