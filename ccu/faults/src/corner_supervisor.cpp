@@ -58,6 +58,8 @@ void CornerSupervisor::rejoin() {
   cfg.initial_curve = good.curve;
   calibrator_.emplace(cfg);
   calibrator_->set_friction_stiffness(good.stiffness_kN_per_rev);
+  fusion_.reset();
+  last_fed_time_s_ = std::numeric_limits<double>::quiet_NaN();
   ++restarts_;
 }
 
@@ -82,6 +84,9 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
   const bool sensors_ok = monitor_.ok(Part::LoadCell) && monitor_.ok(Part::Resolver);
   if (check.usable() && check.load_cell_present && sensors_ok && !was_lost) {
     e = calibrator_->update(calibration::Sample{r.time_s, r.position_rev, r.load_cell_kN});
+    const double dt_s = std::isfinite(last_fed_time_s_) ? r.time_s - last_fed_time_s_ : 0.0;
+    fused_kN_ = fusion_.update(e, dt_s);
+    if (e.valid) last_fed_time_s_ = r.time_s;
     fed = &e;
     ++fed_;
     if (e.valid) {
@@ -112,7 +117,7 @@ void CornerSupervisor::refresh_view(const CornerReading* r, const SampleCheck* c
   if (r != nullptr) {
     const bool lc_present = c->load_cell_present;
     if (lc_ok && res_ok && e != nullptr && e->valid) {
-      view_.force_estimate_kN = e->force_kN;
+      view_.force_estimate_kN = fused_kN_;
       view_.source = EstimateSource::Calibrator;
     } else if (res_ok && (!lc_ok || !lc_present)) {
       const calibration::Curve& curve = lc_ok ? calibrator_->curve() : trusted_curve_;

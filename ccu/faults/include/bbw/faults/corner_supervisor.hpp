@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "bbw/calibration/calibrator.hpp"
+#include "bbw/calibration/fusion.hpp"
 #include "bbw/calibration/config.hpp"
 #include "bbw/corner_unit/controller.hpp"
 #include "bbw/faults/fault_monitor.hpp"
@@ -68,6 +69,10 @@ class CornerSupervisor {
   Target corner_;
   SampleGuard guard_;
   std::optional<calibration::Calibrator> calibrator_;
+  // f_hat fused with the curve by the curve's learned error (calibration/fusion.hpp).
+  calibration::EstimateFusion fusion_{calibration::FusionParams{}};
+  double fused_kN_ = 0.0;
+  double last_fed_time_s_ = std::numeric_limits<double>::quiet_NaN();
   FaultMonitor monitor_;
   LastGoodCalibration last_good_;
   CornerView view_;
