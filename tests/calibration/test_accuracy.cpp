@@ -169,3 +169,23 @@ TEST(EstimateFusion, PassesThroughBeforeCalibrationAndRejectsBadParams) {
   bad.load_cell_noise_kN = 0.0;
   EXPECT_THROW(EstimateFusion{bad}, std::invalid_argument);
 }
+
+// The same sweep with other noise seeds: the worst case over the 14 temperatures must stay
+// within the paper's 0.27 kN on every one (our 0.2 kN target is a figure we report, not a
+// guarantee: the load-cell noise alone reaches about 0.15 kN over 400 000 samples).
+class CalibratorSeeds : public ::testing::TestWithParam<int> {};
+
+TEST_P(CalibratorSeeds, WorstCaseWithinThePapersFigure) {
+  auto sc = bbw::scenario::load_scenario(source_path("config/scenarios/paper_rig_sweep.yaml"));
+  sc.seed = static_cast<std::uint64_t>(GetParam());
+  const auto cfg = load_config(source_path("config/calibrator/robust.yaml"));
+  double worst = 0.0;
+  for (std::size_t i = 0; i < sc.corners.size(); ++i) {
+    const auto r = run_recording(cfg, record_corner(sc, i));
+    worst = std::max(worst, r.score.max_abs_error_kN);
+  }
+  std::printf("seed %d: worst max |error| over 14 temperatures %.3f kN\n", GetParam(), worst);
+  EXPECT_LE(worst, 0.27);
+}
+
+INSTANTIATE_TEST_SUITE_P(NoiseSeeds, CalibratorSeeds, ::testing::Values(1, 2, 3, 4, 5));
