@@ -287,4 +287,33 @@ TEST_F(SecureDds, PermissionsAreBoundToTheirCertificateSubject) {
   EXPECT_NO_THROW(Participant p(o));
 }
 
+// bbw_intruder (security/tools) as a separate process next to a certified corner: as rogue and
+// as unsecured it starts and writes but never matches, as a certified corner it is refused the
+// command writer; the corner receives nothing. Its JSON line is what system tests will read.
+TEST_F(SecureDds, IntruderProcessNeverReachesACertifiedCorner) {
+  Events events;
+  Participant fl(secure(215, "fl"));
+  bbw::dds::Reader<CommandT> fl_commands(fl, bbw::dds::kCommandTopic, "command_reader_lockstep", events);
+  const std::string tool = std::string(BBW_TEST_BINARY_DIR) + "/bin/bbw_intruder";
+  for (const std::string as : {"rogue", "none", "corner"}) {
+    const auto r = bbw::test::run_shell(bbw::test::quote(tool) + " --as " + as + " --corner RR --domain 215 --keys " +
+                                        bbw::test::quote(keys_->dir().string()) + " --duration-s 2 2>/dev/null");
+    ASSERT_EQ(r.status, 0) << as << ": " << r.output;
+    const std::string writer = as == "corner" ? "false" : "true";
+    EXPECT_NE(r.output.find("{\"as\":\"" + as + "\",\"participant\":true,\"writer\":" + writer + ",\"max_matched\":0,"),
+              std::string::npos)
+        << r.output;
+    if (as != "corner") {
+      EXPECT_EQ(r.output.find("\"written\":0}"), std::string::npos) << as << " wrote nothing: " << r.output;
+    }
+  }
+  bbw::msg::ClampCommand in;
+  EXPECT_FALSE(fl_commands.take(in)) << "a certified corner received an intruder's command";
+  EXPECT_EQ(fl_commands.matched(), 0);
+  // Control: the corner is reachable; a certified CCU on this domain matches it.
+  Participant ccu(secure(215, "ccu"));
+  bbw::dds::Writer<CommandT> commands(ccu, bbw::dds::kCommandTopic, "command_writer_lockstep", events);
+  EXPECT_TRUE(events.wait_for(kMatchTimeout, [&] { return fl_commands.matched() == 1; }));
+}
+
 }  // namespace
