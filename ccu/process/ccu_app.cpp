@@ -1,11 +1,14 @@
 #include "ccu_app.hpp"
 
+#include <signal.h>
+
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
 
 #include "bbw/dds/convert.hpp"
 #include "bbw/dds/topics.hpp"
+#include "bbw/faults/link_faults.hpp"
 #include "bbw/launch/stats_file.hpp"
 
 namespace bbw::ccu {
@@ -14,24 +17,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::vector<CornerChannel> make_channels(const scenario::Scenario& s, const calibration::CalibratorConfig& config) {
+std::vector<CornerChannel> make_channels(const scenario::Scenario& s) {
   std::vector<CornerChannel> out;
-  bool seen[dds::kCornerCount] = {};
-  for (std::size_t i = 0; i < s.corners.size(); ++i) {
-    const auto c = dds::parse_corner(s.corners[i].name);
-    if (!c) {
-      throw std::invalid_argument(s.file + ": corner '" + s.corners[i].name +
-                                  "' cannot run over DDS (names must be FL, FR, RL or RR)");
-    }
-    if (seen[dds::corner_index(*c)]) throw std::invalid_argument(s.file + ": corner " + s.corners[i].name + " appears twice");
-    seen[dds::corner_index(*c)] = true;
+  for (const auto& c : s.corners) {
+    const auto corner = dds::parse_corner(c.name);  // CcuCore has checked the names
     CornerChannel ch;
-    ch.corner = *c;
-    ch.scenario_index = i;
-    ch.calibrator = std::make_unique<calibration::Calibrator>(config);
+    ch.corner = *corner;
+    ch.slot = dds::corner_index(*corner);
     out.push_back(std::move(ch));
   }
-  if (out.empty()) throw std::invalid_argument(s.file + ": no corners");
   const double ratio = s.ccu_period_s / s.plant_dt_s;
   if (std::fabs(ratio - std::round(ratio)) > 1e-9 || std::round(ratio) < 1 || std::round(ratio) > msg::MAX_BLOCK_SAMPLES) {
     throw std::invalid_argument(s.file + ": ccu_period_s / plant_dt_s must be an integer in [1, 64]");
@@ -44,10 +38,32 @@ dds::ParticipantOptions named(dds::ParticipantOptions p) {
   return p;
 }
 
+// The first period that starts at or after time_s.
+std::uint64_t step_at(double time_s, double period_s) {
+  return static_cast<std::uint64_t>(std::max(0.0, std::ceil(time_s / period_s - 1e-9)));
+}
+
+faults::CornerReading reading_from(const msg::MeasurementSample& s) {
+  faults::CornerReading r;
+  r.seq = s.seq();
+  r.time_s = s.time_s();
+  r.position_rev = s.position_rev();
+  r.speed_rev_per_s = s.speed_rev_s();
+  r.load_cell_kN = s.force_internal_kN();
+  r.motor_current_A = s.motor_current_A();
+  r.force_command_kN = (s.status() & msg::STATUS_FORCE_MODE) ? s.command() : std::nan("");
+  return r;
+}
+
+std::uint8_t feedback_code(const std::optional<corner_unit::ForceFeedback>& f) {
+  if (!f) return msg::FEEDBACK_OWN;
+  return *f == corner_unit::ForceFeedback::Curve ? msg::FEEDBACK_CURVE : msg::FEEDBACK_LOAD_CELL;
+}
+
 const char* kCsvHeader =
     "time_s,seq,block_seq,position_rev,speed_rev_s,force_internal_kN,force_external_kN,force_true_kN,"
     "temperature_C,motor_current_A,command,force_mode,estimate_kN,friction_kN,curve_kN,fused_kN,valid,"
-    "calibrated\n";
+    "calibrated,source,available\n";
 
 }  // namespace
 
@@ -56,9 +72,9 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
     : scenario_(scenario),
       options_(options),
       events_(events),
-      planner_(scenario),
+      core_(scenario, calibrator, options.fusion_weight),
       periods_(static_cast<std::uint64_t>(std::ceil(scenario.duration_s / scenario.ccu_period_s - 1e-9))),
-      channels_(make_channels(scenario, calibrator)),
+      channels_(make_channels(scenario)),
       participant_(named(options.participant)),
       blocks_(participant_, dds::kMeasurementTopic,
               dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_reader, events),
@@ -66,23 +82,36 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
       commands_(participant_, dds::kCommandTopic,
                 dds::profiles_for(options.mode == ClockMode::Lockstep).command_writer, events),
       calibration_(participant_, dds::kCalibrationTopic, "state_writer", events) {
-  if (!(options.fusion_weight >= 0.0 && options.fusion_weight <= 1.0)) {
-    throw std::invalid_argument("fusion weight must be in [0, 1]");
-  }
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
+  detections_.reserve(256);
+  if (options.process_faults) {
+    for (const faults::ProcessAction& a : faults::process_actions(options.schedule)) {
+      if (a.target == faults::Target::CCU) {
+        if (a.kind == faults::ProcessAction::Kind::Kill && !kill_at_s_) kill_at_s_ = a.at_s;
+      } else if (a.kind == faults::ProcessAction::Kind::Restart) {
+        restarts_.emplace_back(step_at(a.at_s, scenario.ccu_period_s), *faults::corner_slot(a.target));
+      }
+    }
+  }
+  if (options.out_dir.empty()) return;
   for (auto& ch : channels_) {
-    if (options.out_dir.empty()) continue;
     const std::string file = options.out_dir + "/ccu_" + dds::corner_name(ch.corner) + ".csv";
     ch.csv = std::fopen(file.c_str(), "w");
     if (ch.csv == nullptr) throw std::runtime_error(file + ": cannot write");
     std::fputs(kCsvHeader, ch.csv);
   }
+  const std::string file = options.out_dir + "/ccu_periods.csv";
+  periods_csv_ = std::fopen(file.c_str(), "w");
+  if (periods_csv_ == nullptr) throw std::runtime_error(file + ": cannot write");
+  std::fputs("time_s,demand_total_kN,command_total_kN,cmd_FL,cmd_FR,cmd_RL,cmd_RR,avail_FL,avail_FR,avail_RL,avail_RR\n",
+             periods_csv_);
 }
 
 CcuApp::~CcuApp() {
   for (auto& ch : channels_) {
     if (ch.csv != nullptr) std::fclose(ch.csv);
   }
+  if (periods_csv_ != nullptr) std::fclose(periods_csv_);
 }
 
 CornerChannel* CcuApp::channel(std::uint8_t wire_id) {
@@ -92,20 +121,15 @@ CornerChannel* CcuApp::channel(std::uint8_t wire_id) {
   return nullptr;
 }
 
-std::string CcuApp::missing_corners(bool (*pred)(const CornerChannel&)) const {
-  std::string out;
-  for (const auto& ch : channels_) {
-    if (!pred(ch)) out += (out.empty() ? "" : ", ") + std::string(dds::corner_name(ch.corner));
-  }
-  return out;
-}
+double CcuApp::realtime_now_s() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
 
 void CcuApp::drain_health() {
   msg::CornerHealth h;
   while (health_.take(h)) {
     if (CornerChannel* ch = channel(h.corner_id())) {
+      if (h.incarnation() < ch->health_incarnation) continue;  // an older process's last word
+      ch->health_incarnation = h.incarnation();
       ch->health = h.status();
-      if (h.status() == msg::HEALTH_FINISHED) ch->finished = true;
     }
   }
 }
@@ -119,7 +143,10 @@ bool CcuApp::wait_for_corners(std::string& error) {
     return all;
   });
   if (!ok && !events_.interrupted()) {
-    const std::string missing = missing_corners([](const CornerChannel& c) { return c.health >= 0; });
+    std::string missing;
+    for (const auto& ch : channels_) {
+      if (ch.health < 0) missing += (missing.empty() ? "" : ", ") + std::string(dds::corner_name(ch.corner));
+    }
     error = "corners not discovered within " + std::to_string(options_.discovery_timeout.count()) +
             " ms: " + (missing.empty() ? std::string("(endpoints incomplete)") : missing) +
             " (measurement writers matched " + std::to_string(blocks_.matched()) + " of " + std::to_string(n) + ")";
@@ -127,29 +154,82 @@ bool CcuApp::wait_for_corners(std::string& error) {
   return ok;
 }
 
-void CcuApp::send_command(CornerChannel& ch, std::uint64_t step, bool stop) {
+void CcuApp::send_commands(std::uint64_t step, bool stop, bool log) {
   const double t = static_cast<double>(step) * scenario_.ccu_period_s;
-  const PlannedCommand p = planner_.at(ch.scenario_index, t);
-  msg::ClampCommand c;
-  c.corner_id(static_cast<std::uint8_t>(dds::corner_index(ch.corner)));
-  c.seq(ch.command_seq++);
-  c.step(step);
-  c.time_s(t);
-  c.mode(p.mode == CommandMode::Force ? msg::MODE_FORCE : msg::MODE_PROFILE);
-  c.clamp_force_kN(p.clamp_force_kN);
-  c.valid(!stop);
-  c.use_friction_comp(options_.friction_feedback);
-  c.calibration_version(ch.calibration_version);
-  c.friction_estimate_kN(ch.last_friction_kN);
-  c.stop(stop);
-  commands_.write(c);
+  const auto& plans = core_.plan(t);
+  double total = 0.0;
+  for (auto& ch : channels_) {
+    const CornerPlan& p = plans[ch.slot];
+    msg::ClampCommand c;
+    c.corner_id(static_cast<std::uint8_t>(ch.slot));
+    c.seq(ch.command_seq++);
+    c.step(step);
+    c.time_s(t);
+    c.mode(p.mode == CommandMode::Force ? msg::MODE_FORCE : msg::MODE_PROFILE);
+    c.clamp_force_kN(p.clamp_force_kN);
+    c.valid(!stop);
+    c.use_friction_comp(options_.friction_feedback);
+    c.calibration_version(ch.calibration_version);
+    c.friction_estimate_kN(0.0);
+    c.stop(stop);
+    c.feedback_override(feedback_code(p.feedback));
+    c.override_curve_a_kN_per_rev3(p.curve.a);
+    c.override_curve_b_kN_per_rev2(p.curve.b);
+    c.override_curve_c_kN_per_rev(p.curve.c);
+    c.override_curve_d_kN(p.curve.d);
+    commands_.write(c);
+    if (p.mode == CommandMode::Force) total += p.clamp_force_kN;
+  }
+  if (periods_csv_ != nullptr && !stop && log) {
+    char line[512];
+    int n = std::snprintf(line, sizeof(line), "%.6f,%.9g,%.9g", t, core_.demand_total_kN(t), total);
+    for (std::size_t s = 0; s < kSlots; ++s) {
+      const bool has = core_.has(s);
+      n += std::snprintf(line + n, sizeof(line) - static_cast<std::size_t>(n), has ? ",%.9g" : ",nan",
+                         has && plans[s].mode == CommandMode::Force ? plans[s].clamp_force_kN : std::nan(""));
+    }
+    for (std::size_t s = 0; s < kSlots; ++s) {
+      n += std::snprintf(line + n, sizeof(line) - static_cast<std::size_t>(n), ",%d",
+                         core_.has(s) && plans[s].available ? 1 : 0);
+    }
+    line[n++] = '\n';
+    std::fwrite(line, 1, static_cast<std::size_t>(n), periods_csv_);
+  }
 }
 
-void CcuApp::process_block(const msg::MeasurementBlock& b) {
+void CcuApp::publish_calibration(CornerChannel& ch, double time_s) {
+  const faults::CornerSupervisor& sup = core_.supervisor(ch.slot);
+  const auto fits = sup.calibrator().stats().fits_accepted;
+  const auto restarts = sup.calibrator_restarts();
+  if (fits == ch.published_fits && restarts == ch.published_restarts) return;
+  // A fit was accepted, or the calibrator restarted from the last good curve (a rejoin).
+  ch.published_fits = fits;
+  ch.published_restarts = restarts;
+  ++ch.calibration_version;
+  msg::CalibrationState state;
+  dds::to_msg(sup.calibrator(), static_cast<std::uint8_t>(ch.slot), ch.calibration_version, time_s, state);
+  calibration_.write(state);
+}
+
+void CcuApp::process_block(const msg::MeasurementBlock& b, const eprosima::fastdds::dds::SampleInfo& info,
+                           double arrival_s) {
   CornerChannel* ch = channel(b.corner_id());
   if (ch == nullptr) {
     ++unknown_corner_blocks_;  // a corner id that does not exist in this scenario
     return;
+  }
+  ch->instance = info.instance_handle;
+  if (!ch->have_handles || ch->writer != info.publication_handle) {
+    ch->writer = info.publication_handle;
+    ch->writer_alive = true;
+    ch->have_handles = true;
+  }
+  if (b.incarnation() != ch->incarnation) {
+    // A restarted process: its block and sample numbering start where it joined.
+    ch->incarnation = b.incarnation();
+    ch->next_block = b.block_seq();
+    ch->next_sample_seq = b.samples().empty() ? 1 : b.samples().front().seq();
+    ++ch->rejoins;
   }
   if (b.block_seq() != ch->next_block) ++ch->block_gaps;
   ch->next_block = b.block_seq() + 1;
@@ -160,18 +240,13 @@ void CcuApp::process_block(const msg::MeasurementBlock& b) {
   for (const auto& s : b.samples()) {
     ++ch->samples_received;
     ch->next_sample_seq = s.seq() + 1;
-    calibration::Estimate e;
-    if (dds::is_finite(s)) {
-      e = ch->calibrator->update(dds::to_calibration_sample(s));
-    } else {
-      ++ch->samples_invalid;
-    }
-    if (!e.valid) e.force_kN = e.friction_kN = e.curve_force_kN = std::nan("");
-    ch->last_friction_kN = e.valid ? e.friction_kN : ch->last_friction_kN;
-    const double fused = e.valid ? fuse(e, s.force_internal_kN(), options_.fusion_weight) : std::nan("");
+    const faults::CornerReading r = reading_from(s);
+    const std::uint64_t rejected_before = core_.supervisor(ch->slot).guard().rejected();
+    const SampleOutcome& o = core_.on_sample(ch->slot, r, arrival_s);
+    if (core_.supervisor(ch->slot).guard().rejected() != rejected_before) ++ch->samples_invalid;
     if (ch->csv != nullptr) {
       // Shortest round-trip decimal form (std::to_chars): exact, and far cheaper than %.17g.
-      char line[640];
+      char line[700];
       char* p = line;
       char* const last = line + sizeof(line);
       auto put = [&](double v) {
@@ -190,24 +265,100 @@ void CcuApp::process_block(const msg::MeasurementBlock& b) {
         put(v);
       }
       put_u((s.status() & msg::STATUS_FORCE_MODE) ? 1 : 0);
-      for (double v : {e.force_kN, e.friction_kN, e.curve_force_kN, fused}) put(v);
-      put_u(e.valid ? 1 : 0);
-      put_u(e.calibrated ? 1 : 0);
+      const double nan = std::nan("");
+      for (double v : {o.valid ? o.estimate_kN : nan, o.valid ? o.friction_kN : nan, o.valid ? o.curve_kN : nan,
+                       o.valid ? o.fused_kN : nan}) {
+        put(v);
+      }
+      put_u(o.valid ? 1 : 0);
+      put_u(o.calibrated ? 1 : 0);
+      put_u(static_cast<unsigned long long>(core_.supervisor(ch->slot).view().source));
+      put_u(core_.supervisor(ch->slot).view().available ? 1 : 0);
       p[-1] = '\n';
       std::fwrite(line, 1, static_cast<std::size_t>(p - line), ch->csv);
     }
   }
   if (b.block_seq() + 1 >= periods_) ch->finished = true;
-  // Publish the model when a fit was accepted.
-  const auto& st = ch->calibrator->stats();
-  if (st.fits_accepted != ch->published_fits) {
-    ch->published_fits = st.fits_accepted;
-    ++ch->calibration_version;
-    msg::CalibrationState state;
-    dds::to_msg(*ch->calibrator, b.corner_id(), ch->calibration_version,
-                b.samples().empty() ? 0.0 : b.samples().back().time_s(), state);
-    calibration_.write(state);
+  publish_calibration(*ch, b.samples().empty() ? arrival_s : b.samples().back().time_s());
+}
+
+void CcuApp::drain_blocks(double arrival_s) {
+  eprosima::fastdds::dds::SampleInfo info;
+  const bool realtime = options_.mode == ClockMode::Realtime;
+  while (blocks_.take(block_, info)) process_block(block_, info, realtime ? realtime_now_s() : arrival_s);
+}
+
+// QoS events into link events. Realtime: at the time they happened. Lockstep: deadlines are
+// not used (time is simulated: CornerSupervisor::tick finds a silent corner), and a lost
+// writer is acted on only while its corner's block is missing (see run()), so a slow machine
+// cannot change the result.
+void CcuApp::drain_qos_events(double now_s, bool lockstep) {
+  dds::QosEvent e;
+  while (blocks_.take_event(e)) {
+    for (auto& ch : channels_) {
+      if (!ch.have_handles) continue;
+      const double t = lockstep ? now_s : std::chrono::duration<double>(e.at - t0_).count();
+      if (e.kind == dds::QosEvent::Kind::DeadlineMissed && e.handle == ch.instance) {
+        ++ch.deadlines_missed;
+        if (!lockstep) core_.on_link_event(ch.slot, faults::LinkEvent::DeadlineMissed, t);
+      } else if (e.kind == dds::QosEvent::Kind::LivelinessLost && e.handle == ch.writer) {
+        ++ch.liveliness_lost;
+        ch.writer_alive = false;
+        if (!lockstep) core_.on_link_event(ch.slot, faults::LinkEvent::LivelinessLost, t);
+      } else if (e.kind == dds::QosEvent::Kind::LivelinessRecovered && e.handle == ch.writer) {
+        ch.writer_alive = true;
+      }
+    }
   }
+  record_detections();
+}
+
+void CcuApp::record_detections() {
+  for (auto& ch : channels_) {
+    const faults::FaultMonitor& m = core_.supervisor(ch.slot).monitor();
+    for (std::size_t p = 0; p < ch.seen.size(); ++p) {
+      const faults::Diagnosis& d = m.diagnosis(static_cast<faults::Part>(p));
+      faults::Diagnosis& seen = ch.seen[p];
+      if (d.present && (!seen.present || d.detected_s != seen.detected_s || d.finding != seen.finding)) {
+        if (detections_.size() < detections_.capacity()) detections_.push_back({ch.slot, d.finding, d.onset_s, d.detected_s});
+      }
+      seen = d;
+    }
+  }
+}
+
+void CcuApp::after_period(double now_s) {
+  core_.tick(now_s);
+  record_detections();
+}
+
+bool CcuApp::wait_for_rejoin(CornerChannel& ch, std::uint32_t incarnation, std::string& error) {
+  const bool ok = events_.wait_for(options_.discovery_timeout, [&] {
+    drain_health();
+    return ch.health_incarnation >= incarnation &&
+           (ch.health == msg::HEALTH_STARTING || ch.health == msg::HEALTH_RUNNING);
+  });
+  if (ok) ch.writer_alive = true;  // its block is expected from now on
+  if (!ok && !events_.interrupted()) {
+    error = std::string("restarted corner ") + dds::corner_name(ch.corner) + " did not join within " +
+            std::to_string(options_.discovery_timeout.count()) + " ms";
+  }
+  return ok;
+}
+
+void CcuApp::freeze_for_kill(double at_s) {
+  // The scheduled CCU kill: keep the logs up to this instant, then stop dead. From SIGSTOP on
+  // nothing is sent (not even liveliness), as after a crash; the launcher SIGKILLs us.
+  sim_s_ = at_s;
+  wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
+  for (auto& ch : channels_) {
+    if (ch.csv != nullptr) std::fflush(ch.csv);
+  }
+  if (periods_csv_ != nullptr) std::fflush(periods_csv_);
+  if (!options_.out_dir.empty()) write_stats(options_.out_dir + "/ccu.stats");
+  ::raise(SIGSTOP);
+  // Continued instead of killed (nobody carried the kill out): stop without a word.
+  ::_exit(kExitRuntime);
 }
 
 int CcuApp::run(std::string& error) {
@@ -215,28 +366,51 @@ int CcuApp::run(std::string& error) {
   // Initial model: every corner knows the thresholds and initial curve before period 0.
   for (auto& ch : channels_) {
     msg::CalibrationState state;
-    dds::to_msg(*ch.calibrator, static_cast<std::uint8_t>(dds::corner_index(ch.corner)), 0, 0.0, state);
+    dds::to_msg(core_.supervisor(ch.slot).calibrator(), static_cast<std::uint8_t>(ch.slot), 0, 0.0, state);
     calibration_.write(state);
   }
-  const auto wall0 = Clock::now();
+  const double T = scenario_.ccu_period_s;
+  t0_ = Clock::now();
   int rc = kExitOk;
+  std::uint32_t expected_incarnation[kSlots] = {};
   if (options_.mode == ClockMode::Lockstep) {
     for (std::uint64_t k = 0; k < periods_ && !events_.interrupted(); ++k) {
-      for (auto& ch : channels_) send_command(ch, k, false);
-      // Wait until every corner's block k has arrived.
-      const bool ok = events_.wait_for(options_.peer_timeout, [&] {
-        while (blocks_.take(block_)) process_block(block_);
+      const double t_k = static_cast<double>(k) * T;
+      if (kill_at_s_ && t_k >= *kill_at_s_ - 1e-9) freeze_for_kill(t_k);
+      for (const auto& [step, slot] : restarts_) {
+        if (step != k) continue;
+        for (auto& ch : channels_) {
+          if (ch.slot == slot && !wait_for_rejoin(ch, ++expected_incarnation[slot], error)) return kExitPeerLost;
+        }
+      }
+      send_commands(k, false);
+      const double t_end = t_k + T;
+      // Wait until every corner's block k has arrived, or its writer is gone (a dead process).
+      // A command is re-sent every 200 ms without progress: a corner that has just (re)joined
+      // may have matched our writer only after it was sent.
+      auto pred = [&] {
+        drain_blocks(t_end);
         drain_health();
+        drain_qos_events(t_end, true);
         for (const auto& ch : channels_) {
           if (ch.health == msg::HEALTH_FAILED) return true;
-          if (ch.next_block <= k) return false;
+          if (ch.next_block <= k && ch.writer_alive) return false;
         }
         return true;
-      });
-      for (const auto& ch : channels_) {
+      };
+      const auto give_up = Clock::now() + options_.peer_timeout;
+      bool ok = false;
+      for (;;) {
+        ok = events_.wait_until(std::min(give_up, Clock::now() + std::chrono::milliseconds(200)), pred);
+        if (ok || events_.interrupted() || Clock::now() >= give_up) break;
+        send_commands(k, false, false);
+      }
+      for (auto& ch : channels_) {
         if (ch.health == msg::HEALTH_FAILED) {
           error = std::string("corner ") + dds::corner_name(ch.corner) + " reported failure at period " + std::to_string(k);
           rc = kExitPeerLost;
+        } else if (ch.next_block <= k && !ch.writer_alive) {
+          core_.on_link_event(ch.slot, faults::LinkEvent::LivelinessLost, t_end);
         }
       }
       if (rc != kExitOk) break;
@@ -251,46 +425,50 @@ int CcuApp::run(std::string& error) {
         rc = kExitPeerLost;
         break;
       }
+      after_period(t_end);
       periods_done_ = k + 1;
     }
   } else {
-    for (auto& ch : channels_) send_command(ch, 0, false);
-    // Corners pace themselves; answer each block with the command for its next period. The
-    // run ends when every corner has delivered its last block, or at a bounded wall time.
-    const auto limit = wall0 + std::chrono::duration_cast<Clock::duration>(
-                                   std::chrono::duration<double>(scenario_.duration_s * 1.5 + 5.0));
-    events_.wait_until(limit, [&] {
-      while (blocks_.take(block_)) {
-        process_block(block_);
-        if (CornerChannel* ch = channel(block_.corner_id()); ch != nullptr && block_.block_seq() + 1 < periods_) {
-          send_command(*ch, block_.block_seq() + 1, false);
-        }
-      }
-      drain_health();
+    // Realtime: the CCU's clock. Every period it takes what has arrived, checks deadlines and
+    // sends every corner its command for the next period; QoS events are handled as they come.
+    send_commands(0, false);
+    for (std::uint64_t k = 1; k <= periods_ && !events_.interrupted(); ++k) {
+      const auto wake = t0_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                                  static_cast<double>(k) * T));
+      events_.wait_until(wake, [&] {
+        drain_blocks(0.0);
+        drain_health();
+        drain_qos_events(0.0, false);
+        return false;
+      });
+      if (events_.interrupted()) break;
+      const double t_k = static_cast<double>(k) * T;
+      after_period(realtime_now_s());
+      periods_done_ = k;
+      if (k == periods_) break;
+      if (kill_at_s_ && t_k >= *kill_at_s_ - 1e-9) freeze_for_kill(t_k);
+      send_commands(k, false);
+    }
+    // The last blocks: wait briefly for every corner that is still linked.
+    events_.wait_for(std::chrono::milliseconds(500), [&] {
+      drain_blocks(0.0);
+      drain_qos_events(0.0, false);
       for (const auto& ch : channels_) {
-        if (!ch.finished) return false;
+        const auto& m = core_.supervisor(ch.slot).monitor();
+        if (!ch.finished && m.ok(faults::Part::Network) && m.ok(faults::Part::Process)) return false;
       }
       return true;
     });
-    std::uint64_t min_blocks = periods_;
-    for (const auto& ch : channels_) min_blocks = std::min(min_blocks, ch.next_block);
-    periods_done_ = min_blocks;
-    if (!events_.interrupted() && periods_done_ < periods_) {
-      std::string late;
-      for (const auto& ch : channels_) {
-        if (ch.next_block < periods_) late += (late.empty() ? "" : ", ") + std::string(dds::corner_name(ch.corner));
-      }
-      error = "run did not complete within its wall-time bound; incomplete corners: " + late;
-      rc = kExitPeerLost;
-    }
+    record_detections();
   }
-  wall_s_ = std::chrono::duration<double>(Clock::now() - wall0).count();
-  sim_s_ = static_cast<double>(periods_done_) * scenario_.ccu_period_s;
-  for (auto& ch : channels_) send_command(ch, periods_, true);
+  wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
+  sim_s_ = static_cast<double>(periods_done_) * T;
+  send_commands(periods_, true);
   commands_.get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
   for (auto& ch : channels_) {
     if (ch.csv != nullptr) std::fflush(ch.csv);
   }
+  if (periods_csv_ != nullptr) std::fflush(periods_csv_);
   return rc;
 }
 
@@ -301,9 +479,11 @@ void CcuApp::write_stats(const std::string& file) const {
   w.set("periods_done", static_cast<unsigned long long>(periods_done_));
   w.set("sim_s", sim_s_);
   w.set("wall_s", wall_s_);
+  w.set("killed_at_s", kill_at_s_ ? sim_s_ : -1.0);
   w.set("measurement_deadlines_missed", static_cast<unsigned long long>(blocks_.deadlines_missed()));
   w.set("measurement_liveliness_lost", static_cast<unsigned long long>(blocks_.liveliness_lost()));
   w.set("measurement_samples_lost", static_cast<unsigned long long>(blocks_.samples_lost()));
+  w.set("qos_events_dropped", static_cast<unsigned long long>(blocks_.events_dropped()));
   w.set("unknown_corner_blocks", static_cast<unsigned long long>(unknown_corner_blocks_));
   w.set("command_write_failures", static_cast<unsigned long long>(commands_.write_failures()));
   std::string corners;
@@ -311,23 +491,40 @@ void CcuApp::write_stats(const std::string& file) const {
   w.set("corners", corners);
   for (const auto& ch : channels_) {
     const std::string p = std::string(dds::corner_name(ch.corner)) + ".";
-    const auto& st = ch.calibrator->stats();
+    const faults::CornerSupervisor& sup = core_.supervisor(ch.slot);
+    const auto& st = sup.calibrator().stats();
     w.set(p + "blocks_received", static_cast<unsigned long long>(ch.blocks_received));
     w.set(p + "samples_received", static_cast<unsigned long long>(ch.samples_received));
     w.set(p + "samples_invalid", static_cast<unsigned long long>(ch.samples_invalid));
     w.set(p + "block_gaps", static_cast<unsigned long long>(ch.block_gaps));
     w.set(p + "sample_gaps", static_cast<unsigned long long>(ch.sample_gaps));
+    w.set(p + "rejoins", static_cast<unsigned long long>(ch.rejoins));
+    w.set(p + "deadlines_missed", static_cast<unsigned long long>(ch.deadlines_missed));
+    w.set(p + "liveliness_lost", static_cast<unsigned long long>(ch.liveliness_lost));
+    w.set(p + "guard_rejected", static_cast<unsigned long long>(sup.guard().rejected()));
+    w.set(p + "calibrator_restarts", static_cast<unsigned long long>(sup.calibrator_restarts()));
     w.set(p + "fits_accepted", static_cast<unsigned long long>(st.fits_accepted));
     w.set(p + "fits_rejected", static_cast<unsigned long long>(st.fits_rejected));
     w.set(p + "cycles_detected", static_cast<unsigned long long>(st.cycles_detected));
     w.set(p + "samples_rejected", static_cast<unsigned long long>(st.samples_rejected));
     w.set(p + "first_fit_time_s", st.first_fit_time_s);
     w.set(p + "calibration_version", static_cast<unsigned long long>(ch.calibration_version));
-    const auto& c = ch.calibrator->curve();
+    const auto& c = sup.calibrator().curve();
     w.set(p + "curve_a", c.a);
     w.set(p + "curve_b", c.b);
     w.set(p + "curve_c", c.c);
     w.set(p + "curve_d", c.d);
+  }
+  // Every detection in time order of recording: corner, finding, onset, detection time.
+  w.set("detections", static_cast<unsigned long long>(detections_.size()));
+  for (std::size_t i = 0; i < detections_.size(); ++i) {
+    const DetectionRecord& d = detections_[i];
+    const std::string p = "detection." + std::to_string(i) + ".";
+    w.set(p + "corner", std::string(dds::corner_name(static_cast<dds::Corner>(d.slot))));
+    w.set(p + "finding", std::string(faults::to_string(d.finding)));
+    w.set(p + "part", std::string(faults::to_string(faults::part_of(d.finding))));
+    w.set(p + "onset_s", d.onset_s);
+    w.set(p + "detected_s", d.detected_s);
   }
   w.save(file);
 }

@@ -4,7 +4,11 @@
 //   bbw_ccu --scenario FILE [--domain N] [--mode lockstep|realtime] [--out DIR]
 //           [--calibrator FILE.yaml] [--fusion-weight W] [--friction-feedback on|off]
 //           [--discovery-timeout S] [--peer-timeout S]
-//           [--dds-profiles FILE.xml] [--dds-participant-profile NAME]
+//           [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--process-faults]
+//
+// The scenario may carry a fault schedule (docs/faults.md). --process-faults (given by
+// bbw_launch, which carries process faults out) makes the CCU freeze at its scheduled kill for
+// the launcher to SIGKILL it, and hold the lockstep clock at a corner's scheduled restart.
 //
 // Exit: 0 done (130/143 when stopped by SIGINT/SIGTERM), 1 runtime or DDS error, 2 bad
 // arguments or config, 3 corners not discovered in time, 4 a corner lost or failed.
@@ -17,6 +21,7 @@
 
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/dds/domain.hpp"
+#include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/launch/signals.hpp"
 #include "bbw/scenario/load.hpp"
 #include "ccu_app.hpp"
@@ -27,7 +32,7 @@ const char* kUsage =
     "usage: bbw_ccu --scenario FILE [--domain N] [--mode lockstep|realtime] [--out DIR]\n"
     "               [--calibrator FILE.yaml] [--fusion-weight W] [--friction-feedback on|off]\n"
     "               [--discovery-timeout S] [--peer-timeout S]\n"
-    "               [--dds-profiles FILE.xml] [--dds-participant-profile NAME]\n";
+    "               [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--process-faults]\n";
 
 std::chrono::milliseconds seconds_arg(const std::string& key, const std::string& v) {
   char* end = nullptr;
@@ -76,6 +81,7 @@ int main(int argc, char** argv) {
       else if (k == "--peer-timeout") opt.peer_timeout = seconds_arg(k, next());
       else if (k == "--dds-profiles") opt.participant.profiles_file = next();
       else if (k == "--dds-participant-profile") opt.participant.profile = next();
+      else if (k == "--process-faults") opt.process_faults = true;
       else if (k == "-h" || k == "--help") { std::cout << kUsage; return 0; }
       else throw std::invalid_argument("unknown argument '" + k + "'");
     }
@@ -93,7 +99,9 @@ int main(int argc, char** argv) {
   std::optional<bbw::scenario::Scenario> scenario;
   std::optional<bbw::calibration::CalibratorConfig> calibrator;
   try {
-    scenario = bbw::scenario::load_scenario(scenario_file);
+    auto fs = bbw::faults::load_fault_scenario(scenario_file);
+    scenario = std::move(fs.scenario);
+    opt.schedule = std::move(fs.faults);
     calibrator = bbw::calibration::load_config(calibrator_file);
     calibrator->validate();
     if (!opt.out_dir.empty()) {

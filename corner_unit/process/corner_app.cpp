@@ -1,10 +1,14 @@
 #include "corner_app.hpp"
 
+#include <signal.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <stdexcept>
 
 #include "bbw/calibration/maxwell_slip.hpp"
 #include "bbw/dds/topics.hpp"
+#include "bbw/launch/stats_file.hpp"
 
 namespace bbw::corner_process {
 
@@ -29,6 +33,10 @@ const scenario::Scenario& validated(const scenario::Scenario& s, const CornerOpt
                                 s.corners[o.scenario_index].name + "', not " + dds::corner_name(o.corner));
   }
   steps_per_period(s);
+  if (!(o.resume_at_s >= 0.0 && o.resume_at_s < s.duration_s)) {
+    throw std::invalid_argument("resume time " + std::to_string(o.resume_at_s) + " s is outside the scenario (0 to " +
+                                std::to_string(s.duration_s) + " s)");
+  }
   return s;
 }
 
@@ -36,6 +44,8 @@ dds::ParticipantOptions named(dds::ParticipantOptions p, dds::Corner c) {
   if (p.name.empty()) p.name = std::string("bbw_corner_") + dds::corner_name(c);
   return p;
 }
+
+faults::Target target_of(dds::Corner c) { return static_cast<faults::Target>(dds::corner_index(c)); }
 
 }  // namespace
 
@@ -57,14 +67,30 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       commands_(participant_, dds::kCommandTopic,
                 dds::profiles_for(options.mode == ClockMode::Lockstep).command_reader, events),
       calibration_(participant_, dds::kCalibrationTopic, "state_reader", events),
-      my_id_(static_cast<std::uint8_t>(dds::corner_index(options.corner))) {
-  block_.corner_id(static_cast<std::uint8_t>(dds::corner_index(options.corner)));
-  block_.samples().reserve(steps_per_period_);
+      my_id_(static_cast<std::uint8_t>(dds::corner_index(options.corner))),
+      injector_(options.schedule, target_of(options.corner),
+                scenario::corner_seed(scenario.seed + 7777, options.scenario_index)),
+      link_(options.schedule, target_of(options.corner)),
+      watchdog_(options.watchdog),
+      resume_step_(static_cast<std::uint64_t>(std::ceil(options.resume_at_s / scenario.ccu_period_s - 1e-9))) {
+  block_.corner_id(my_id_);
+  block_.incarnation(options.incarnation);
+  block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
+  if (!options.periods_log.empty()) {
+    // A restarted process appends to its predecessor's log.
+    periods_csv_ = std::fopen(options.periods_log.c_str(), options.incarnation == 0 ? "w" : "a");
+    if (periods_csv_ == nullptr) throw std::runtime_error(options.periods_log + ": cannot write");
+    if (options.incarnation == 0) std::fputs("time_s,force_true_kN,applied_kN,watchdog_mode,incarnation\n", periods_csv_);
+  }
+}
+
+CornerApp::~CornerApp() {
+  if (periods_csv_ != nullptr) std::fclose(periods_csv_);
 }
 
 void CornerApp::publish_health(std::uint8_t status) {
   msg::CornerHealth h;
-  h.corner_id(static_cast<std::uint8_t>(dds::corner_index(options_.corner)));
+  h.corner_id(my_id_);
   h.status(status);
   h.samples_published(stats_.samples_published);
   h.blocks_published(stats_.blocks_published);
@@ -74,6 +100,8 @@ void CornerApp::publish_health(std::uint8_t status) {
   h.overruns(stats_.overruns);
   h.max_jitter_s(stats_.max_jitter_s);
   h.time_s(sim_.time_s());
+  h.incarnation(options_.incarnation);
+  h.resume_step(resume_step_);
   health_.write(h);
 }
 
@@ -91,6 +119,13 @@ bool CornerApp::wait_for_ccu(std::string& error) {
   return ok;
 }
 
+double CornerApp::sim_now_s() const {
+  return static_cast<double>(resume_step_) * scenario_.ccu_period_s +
+         std::chrono::duration<double>(Clock::now() - t0_).count();
+}
+
+bool CornerApp::ccu_gone() const { return commands_.liveliness_lost() > 0 && commands_.alive_writers() == 0; }
+
 // Takes every waiting command and calibration state; keeps the newest command.
 void CornerApp::drain_inputs() {
   msg::ClampCommand cmd;
@@ -101,9 +136,16 @@ void CornerApp::drain_inputs() {
       stats_.command_seq_gaps += cmd.seq() > *last_command_seq_ ? cmd.seq() - *last_command_seq_ - 1 : 1;
     }
     last_command_seq_ = cmd.seq();
+    if (cmd.step() < resume_step_ && !cmd.stop()) continue;  // a restarted corner joins at its resume step
     if (!have_command_ || cmd.step() >= latest_command_.step()) {
       latest_command_ = cmd;
       have_command_ = true;
+      if (cmd.valid() && (cmd.mode() == msg::MODE_FORCE || cmd.mode() == msg::MODE_RELEASE)) {
+        // Lockstep (and the start command): the command belongs to its period's start.
+        // Realtime: to its arrival on this corner's clock.
+        const double at = options_.mode == ClockMode::Lockstep || !started_ ? cmd.time_s() : sim_now_s();
+        watchdog_.on_command(at, cmd.mode() == msg::MODE_FORCE ? cmd.clamp_force_kN() : 0.0);
+      }
     }
   }
   msg::CalibrationState state;
@@ -128,19 +170,32 @@ void CornerApp::simulate_period(std::uint64_t k) {
   const double dt = scenario_.plant_dt_s;
   scenario::ExternalInputs ext;
   const bool valid = have_command_ && latest_command_.valid();
-  if (valid && latest_command_.mode() == msg::MODE_FORCE) {
-    ext.force_command_kN = latest_command_.clamp_force_kN();
-  } else if (valid && latest_command_.mode() == msg::MODE_RELEASE) {
-    ext.force_command_kN = 0.0;
-  }
-  if (valid) ++stats_.commands_applied;
+  if (valid && !ccu_lost_) ++stats_.commands_applied;
   const bool calibrated = model_.version > 0 && latest_command_.use_friction_comp();
   if (calibrated) ext.curve = model_.curve;
+  // A CCU fault reaction: the feedback to use instead of the corner's own.
+  if (have_command_ && latest_command_.feedback_override() == msg::FEEDBACK_CURVE) {
+    ext.feedback = corner_unit::ForceFeedback::Curve;
+    ext.curve = scenario::CurveEstimate{latest_command_.override_curve_a_kN_per_rev3(),
+                                        latest_command_.override_curve_b_kN_per_rev2(),
+                                        latest_command_.override_curve_c_kN_per_rev(),
+                                        latest_command_.override_curve_d_kN()};
+  } else if (have_command_ && latest_command_.feedback_override() == msg::FEEDBACK_LOAD_CELL) {
+    ext.feedback = corner_unit::ForceFeedback::LoadCell;
+  }
 
   block_.block_seq(k);
   block_.period_start_s(sim_.time_s());
-  block_.samples().resize(steps_per_period_);
+  block_.samples().clear();
+  faults::WatchdogOutput w;
+  msg::MeasurementSample m;
   for (std::uint64_t i = 0; i < steps_per_period_; ++i) {
+    const double t_end = sim_.time_s() + dt;
+    // Force mode: the CCU's command through the watchdog (hold, then the default, if it is lost).
+    w = watchdog_.at(t_end);
+    if (w.force_command_kN) ext.force_command_kN = w.force_command_kN;
+    if (w.mode == faults::WatchdogMode::Holding && stats_.ccu_lost_s < 0.0) stats_.ccu_lost_s = t_end;
+    if (w.mode == faults::WatchdogMode::Default && stats_.default_force_s < 0.0) stats_.default_force_s = t_end;
     // Friction the load cell is believed to hold, from the CCU's Maxwell-slip model and this
     // corner's own element states (they depend only on the position history).
     const double x = sim_.last().position_rev;
@@ -154,18 +209,59 @@ void CornerApp::simulate_period(std::uint64_t k) {
                                             model_.delta_rev.size(), model_.stiffness_kN_per_rev.data(), nullptr);
     }
     ext.friction_estimate_kN = calibrated ? friction : 0.0;
+    injector_.prepare(ext, t_end);
     const auto& s = sim_.step(dt, ext);
-    dds::to_msg(s, calibrated && sim_.feedback() == corner_unit::ForceFeedback::Compensated,
-                block_.samples()[i]);
+    dds::to_msg(s, calibrated && sim_.feedback() == corner_unit::ForceFeedback::Compensated, m);
+    // Network faults on the way out: silence drops the sample, a delay holds it back (order kept).
+    if (link_.silenced(s.time_s)) {
+      ++stats_.samples_suppressed;
+    } else if (const double d = link_.delay_s(s.time_s); d > 0.0 || outbox_.size() > 0) {
+      if (d > 0.0) ++stats_.samples_delayed;
+      if (!outbox_.push(s.time_s + d, m)) ++stats_.samples_suppressed;
+    } else if (block_.samples().size() < msg::MAX_BLOCK_SAMPLES) {
+      block_.samples().push_back(m);
+    }
   }
-  block_.first_sample_seq(block_.samples().front().seq());
-  if (blocks_.write(block_)) {
-    ++stats_.blocks_published;
-    stats_.samples_published += steps_per_period_;
-  } else {
-    ++stats_.write_failures;
+  while (block_.samples().size() < msg::MAX_BLOCK_SAMPLES) {
+    auto due = outbox_.pop_due(sim_.time_s() + 1e-9);
+    if (!due) break;
+    block_.samples().push_back(*due);
+  }
+  block_.first_sample_seq(block_.samples().empty() ? 0 : block_.samples().front().seq());
+  // Lockstep: an empty block still tells the CCU that this period is done (time is simulated).
+  // Realtime: nothing to send is nothing sent.
+  if (options_.mode == ClockMode::Lockstep || !block_.samples().empty()) {
+    if (blocks_.write(block_)) {
+      ++stats_.blocks_published;
+      stats_.samples_published += block_.samples().size();
+    } else {
+      ++stats_.write_failures;
+    }
   }
   ++stats_.periods;
+  if (periods_csv_ != nullptr) {
+    std::fprintf(periods_csv_, "%.6f,%.9g,%.9g,%d,%u\n", sim_.time_s(), sim_.last().force_true_kN,
+                 ext.force_command_kN ? *ext.force_command_kN : std::nan(""), static_cast<int>(w.mode),
+                 options_.incarnation);
+  }
+}
+
+void CornerApp::finish_stats(Clock::time_point wall0) {
+  if (stats_.periods > 0) stats_.mean_jitter_s = jitter_sum_s_ / static_cast<double>(stats_.periods);
+  stats_.command_deadlines_missed = commands_.deadlines_missed();
+  stats_.write_failures += blocks_.write_failures();
+  stats_.samples_in_flight = outbox_.size();
+  stats_.first_step = resume_step_;
+  stats_.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
+  if (periods_csv_ != nullptr) std::fflush(periods_csv_);
+}
+
+void CornerApp::freeze_for_kill() {
+  // The scheduled kill: keep the logs up to this instant, then stop dead. From SIGSTOP on the
+  // process sends nothing (no sample, no liveliness), as after a crash; the launcher SIGKILLs it.
+  if (!options_.stats_file.empty()) write_stats(options_.stats_file);
+  ::raise(SIGSTOP);
+  ::_exit(kExitRuntime);  // continued instead of killed: nobody carried the kill out
 }
 
 int CornerApp::run(std::string& error) {
@@ -173,9 +269,15 @@ int CornerApp::run(std::string& error) {
   if (!wait_for_ccu(error)) return events_.interrupted() ? kExitOk : kExitDiscovery;
   publish_health(msg::HEALTH_STARTING);
 
-  // Both modes start at the CCU's first command (step 0): it is the start signal.
+  // Both modes start at the CCU's first command for our first period: it is the start signal.
+  // A restarted corner republishes its health until then (the CCU holds the clock for it).
+  auto republish = Clock::now() + std::chrono::milliseconds(200);
   const bool started = events_.wait_for(options_.discovery_timeout, [&] {
     drain_inputs();
+    if (Clock::now() >= republish) {
+      publish_health(msg::HEALTH_STARTING);
+      republish = Clock::now() + std::chrono::milliseconds(200);
+    }
     return have_command_;
   });
   if (!started) {
@@ -183,34 +285,45 @@ int CornerApp::run(std::string& error) {
     error = "no start command from the CCU within " + std::to_string(options_.discovery_timeout.count()) + " ms";
     return kExitPeerLost;
   }
+  const std::uint64_t first = std::max(resume_step_, latest_command_.step());
+  resume_step_ = first;
+  if (first > 0) sim_.start_at(static_cast<double>(first) * scenario_.ccu_period_s);
   publish_health(msg::HEALTH_RUNNING);
 
   const auto period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(scenario_.ccu_period_s));
-  const auto t0 = Clock::now();
-  double jitter_sum = 0.0;
-  for (std::uint64_t k = 0; k < periods_; ++k) {
+  t0_ = Clock::now();
+  started_ = true;
+  for (std::uint64_t k = first; k < periods_; ++k) {
+    if (options_.process_faults && link_.killed(sim_.time_s() + scenario_.plant_dt_s)) {
+      finish_stats(wall0);
+      freeze_for_kill();
+    }
     if (options_.mode == ClockMode::Lockstep) {
-      // The command for period k is the grant to simulate it.
-      const bool granted = events_.wait_for(options_.peer_timeout, [&] {
-        drain_inputs();
-        return latest_command_.step() >= k || latest_command_.stop();
-      });
-      if (events_.interrupted()) break;
-      if (!granted) {
-        error = "no command for period " + std::to_string(k) + " from the CCU within " +
-                std::to_string(options_.peer_timeout.count()) + " ms";
-        publish_health(msg::HEALTH_FAILED);
-        return kExitPeerLost;
+      if (!ccu_lost_) {
+        // The command for period k is the grant to simulate it. Without a CCU (its command
+        // writer lost its liveliness) the corner runs on alone under its watchdog.
+        const bool granted = events_.wait_for(options_.peer_timeout, [&] {
+          drain_inputs();
+          return latest_command_.step() >= k || latest_command_.stop() || ccu_gone();
+        });
+        if (events_.interrupted()) break;
+        if (!granted) {
+          error = "no command for period " + std::to_string(k) + " from the CCU within " +
+                  std::to_string(options_.peer_timeout.count()) + " ms";
+          publish_health(msg::HEALTH_FAILED);
+          return kExitPeerLost;
+        }
+        if (latest_command_.stop()) break;
+        if (latest_command_.step() < k) ccu_lost_ = true;  // only ccu_gone() ends the wait without a grant
       }
-      if (latest_command_.stop()) break;
     } else {
-      // Pace on the wall clock: period k starts at t0 + k * period.
-      const auto wake = t0 + period * static_cast<long long>(k);
+      // Pace on the wall clock: period k starts at t0 + (k - first) * period.
+      const auto wake = t0_ + period * static_cast<long long>(k - first);
       events_.wait_until(wake, [&] { return events_.interrupted(); });
       if (events_.interrupted()) break;
       const double late_s = std::chrono::duration<double>(Clock::now() - wake).count();
-      jitter_sum += late_s;
+      jitter_sum_s_ += late_s;
       if (late_s > stats_.max_jitter_s) stats_.max_jitter_s = late_s;
       if (late_s > scenario_.ccu_period_s) ++stats_.overruns;
       drain_inputs();
@@ -218,15 +331,44 @@ int CornerApp::run(std::string& error) {
     }
     simulate_period(k);
   }
-  if (stats_.periods > 0) stats_.mean_jitter_s = jitter_sum / static_cast<double>(stats_.periods);
-  stats_.command_deadlines_missed = commands_.deadlines_missed();
-  stats_.write_failures += blocks_.write_failures();
-  // Deliver everything before the writer goes away.
-  blocks_.get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2, 0));
+  finish_stats(wall0);
+  // Deliver everything before the writer goes away (nobody acknowledges without a CCU).
+  const bool alone = ccu_lost_ || ccu_gone() || watchdog_.at(sim_.time_s()).mode == faults::WatchdogMode::Holding ||
+                     watchdog_.at(sim_.time_s()).mode == faults::WatchdogMode::Default;
+  const eprosima::fastrtps::Duration_t ack(alone ? 0 : 2, alone ? 100000000 : 0);
+  blocks_.get().wait_for_acknowledgments(ack);
   publish_health(events_.interrupted() ? msg::HEALTH_FAILED : msg::HEALTH_FINISHED);
-  health_.get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
+  health_.get().wait_for_acknowledgments(ack);
   stats_.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   return kExitOk;
+}
+
+void CornerApp::write_stats(const std::string& file) const {
+  const CornerStats& s = stats_;
+  launch::StatsWriter w;
+  w.set("corner", std::string(dds::corner_name(options_.corner)));
+  w.set("incarnation", static_cast<unsigned long long>(options_.incarnation));
+  w.set("first_step", static_cast<unsigned long long>(s.first_step));
+  w.set("periods", s.periods);
+  w.set("samples_published", s.samples_published);
+  w.set("blocks_published", s.blocks_published);
+  w.set("write_failures", s.write_failures);
+  w.set("commands_received", s.commands_received);
+  w.set("commands_applied", s.commands_applied);
+  w.set("command_seq_gaps", s.command_seq_gaps);
+  w.set("calibrations_applied", s.calibrations_applied);
+  w.set("calibrations_rejected", s.calibrations_rejected);
+  w.set("overruns", s.overruns);
+  w.set("max_jitter_s", s.max_jitter_s);
+  w.set("mean_jitter_s", s.mean_jitter_s);
+  w.set("command_deadlines_missed", s.command_deadlines_missed);
+  w.set("samples_suppressed", s.samples_suppressed);
+  w.set("samples_delayed", s.samples_delayed);
+  w.set("samples_in_flight", s.samples_in_flight);
+  w.set("ccu_lost_s", s.ccu_lost_s);
+  w.set("default_force_s", s.default_force_s);
+  w.set("wall_s", s.wall_s);
+  w.save(file);
 }
 
 }  // namespace bbw::corner_process

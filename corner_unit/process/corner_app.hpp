@@ -6,6 +6,7 @@
 #include <bbw/idl/bbw_msgsPubSubTypes.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -17,6 +18,10 @@
 #include "bbw/dds/participant.hpp"
 #include "bbw/dds/reader.hpp"
 #include "bbw/dds/writer.hpp"
+#include "bbw/faults/ccu_watchdog.hpp"
+#include "bbw/faults/injector.hpp"
+#include "bbw/faults/link_faults.hpp"
+#include "bbw/faults/schedule.hpp"
 #include "bbw/scenario/corner_sim.hpp"
 #include "bbw/scenario/scenario.hpp"
 
@@ -32,6 +37,18 @@ struct CornerOptions {
   std::chrono::milliseconds discovery_timeout{20000};
   std::chrono::milliseconds peer_timeout{10000};  // lockstep: longest wait for the next command
   std::string stats_file;                        // JSON with counters and jitter; "" for none
+  std::string periods_log;                       // per-period CSV (truth, applied command); "" for none
+  // Fault injection (docs/faults.md): sensor and actuator faults through FaultInjector, network
+  // faults on the outgoing samples (LinkFaults, DelayQueue). Process faults only with
+  // process_faults (the launcher carries them out): at its scheduled kill the corner freezes
+  // (SIGSTOP) for the launcher to SIGKILL it.
+  faults::FaultSchedule schedule;
+  bool process_faults = false;
+  faults::CcuWatchdogParams watchdog;
+  // A restarted process: its number and the simulated time it rejoins at (it starts at the
+  // first period at or after it, from a released plant, with sample seq 1).
+  std::uint32_t incarnation = 0;
+  double resume_at_s = 0.0;
 };
 
 // Exit statuses (docs/distributed.md).
@@ -57,6 +74,12 @@ struct CornerStats {
   double max_jitter_s = 0.0;           // realtime: largest wake-up lateness
   double mean_jitter_s = 0.0;
   std::uint64_t command_deadlines_missed = 0;
+  std::uint64_t samples_suppressed = 0;  // not sent: injected network silence
+  std::uint64_t samples_delayed = 0;     // sent late: injected network delay
+  std::uint64_t samples_in_flight = 0;   // still held back by a delay at the end
+  double ccu_lost_s = -1.0;              // simulated time the watchdog found the CCU lost (-1: never)
+  double default_force_s = -1.0;         // ... and went to the default clamp force
+  std::uint64_t first_step = 0;          // the period this incarnation started at
   double wall_s = 0.0;
 };
 
@@ -64,17 +87,25 @@ class CornerApp {
  public:
   // Validates (throws std::invalid_argument) before any DDS entity exists, then creates them.
   CornerApp(const scenario::Scenario& scenario, const CornerOptions& options, dds::Events& events);
+  ~CornerApp();
+  CornerApp(const CornerApp&) = delete;
+  CornerApp& operator=(const CornerApp&) = delete;
 
   // Runs to the end of the scenario (or a stop command, or an interrupt). Returns an ExitCode;
   // `error` explains a non-zero result.
   int run(std::string& error);
   const CornerStats& stats() const { return stats_; }
+  void write_stats(const std::string& file) const;  // key=value (bbw/launch/stats_file.hpp)
 
  private:
   bool wait_for_ccu(std::string& error);
   void drain_inputs();
   void simulate_period(std::uint64_t k);
   void publish_health(std::uint8_t status);
+  double sim_now_s() const;  // realtime: the corner's simulated time from the wall clock
+  bool ccu_gone() const;     // the CCU's command writer lost its liveliness
+  [[noreturn]] void freeze_for_kill();
+  void finish_stats(std::chrono::steady_clock::time_point wall0);
 
   const scenario::Scenario& scenario_;
   CornerOptions options_;
@@ -89,6 +120,17 @@ class CornerApp {
   dds::Reader<msg::ClampCommandPubSubType> commands_;
   dds::Reader<msg::CalibrationStatePubSubType> calibration_;
   std::uint8_t my_id_;
+
+  faults::FaultInjector injector_;
+  faults::LinkFaults link_;
+  faults::CcuWatchdog watchdog_;
+  faults::DelayQueue<msg::MeasurementSample, 1024> outbox_;
+  std::uint64_t resume_step_ = 0;
+  std::chrono::steady_clock::time_point t0_{};  // realtime: wall time of period resume_step_
+  std::FILE* periods_csv_ = nullptr;
+  bool ccu_lost_ = false;   // lockstep: the corner runs on alone
+  bool started_ = false;
+  double jitter_sum_s_ = 0.0;
 
   msg::MeasurementBlock block_;
   msg::ClampCommand latest_command_;

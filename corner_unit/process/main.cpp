@@ -3,6 +3,12 @@
 //   bbw_corner --corner FL|FR|RL|RR --scenario FILE [--domain N] [--mode lockstep|realtime]
 //              [--stats FILE] [--discovery-timeout S] [--peer-timeout S]
 //              [--dds-profiles FILE.xml] [--dds-participant-profile NAME]
+//              [--periods-log FILE] [--process-faults] [--incarnation N --resume-at S]
+//
+// The scenario may carry a fault schedule (docs/faults.md): this corner's sensor, actuator and
+// network faults are injected here. --process-faults (given by bbw_launch) makes the corner
+// freeze at its scheduled kill for the launcher to SIGKILL it; --incarnation/--resume-at start
+// a restarted corner at the scenario time it rejoins.
 //
 // Exit: 0 done (or stopped by SIGINT/SIGTERM: 130/143), 1 runtime or DDS error, 2 bad
 // arguments or config, 3 CCU not discovered in time, 4 CCU lost (no command in time).
@@ -15,6 +21,7 @@
 
 #include "bbw/common/strict_yaml.hpp"
 #include "bbw/dds/domain.hpp"
+#include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/launch/signals.hpp"
 #include "bbw/launch/stats_file.hpp"
 #include "bbw/scenario/load.hpp"
@@ -25,7 +32,8 @@ namespace {
 const char* kUsage =
     "usage: bbw_corner --corner FL|FR|RL|RR --scenario FILE [--domain N] [--mode lockstep|realtime]\n"
     "                  [--stats FILE] [--discovery-timeout S] [--peer-timeout S]\n"
-    "                  [--dds-profiles FILE.xml] [--dds-participant-profile NAME]\n";
+    "                  [--dds-profiles FILE.xml] [--dds-participant-profile NAME]\n"
+    "                  [--periods-log FILE] [--process-faults] [--incarnation N --resume-at S]\n";
 
 std::chrono::milliseconds seconds_arg(const std::string& key, const std::string& v) {
   char* end = nullptr;
@@ -34,26 +42,6 @@ std::chrono::milliseconds seconds_arg(const std::string& key, const std::string&
     throw std::invalid_argument(key + " must be a number of seconds in (0, 3600], got '" + v + "'");
   }
   return std::chrono::milliseconds(static_cast<long long>(s * 1000.0));
-}
-
-void write_stats(const std::string& file, const char* corner, const bbw::corner_process::CornerStats& s) {
-  bbw::launch::StatsWriter w;
-  w.set("corner", std::string(corner));
-  w.set("periods", s.periods);
-  w.set("samples_published", s.samples_published);
-  w.set("blocks_published", s.blocks_published);
-  w.set("write_failures", s.write_failures);
-  w.set("commands_received", s.commands_received);
-  w.set("commands_applied", s.commands_applied);
-  w.set("command_seq_gaps", s.command_seq_gaps);
-  w.set("calibrations_applied", s.calibrations_applied);
-  w.set("calibrations_rejected", s.calibrations_rejected);
-  w.set("overruns", s.overruns);
-  w.set("max_jitter_s", s.max_jitter_s);
-  w.set("mean_jitter_s", s.mean_jitter_s);
-  w.set("command_deadlines_missed", s.command_deadlines_missed);
-  w.set("wall_s", s.wall_s);
-  w.save(file);
 }
 
 }  // namespace
@@ -82,6 +70,20 @@ int main(int argc, char** argv) {
       else if (k == "--peer-timeout") opt.peer_timeout = seconds_arg(k, next());
       else if (k == "--dds-profiles") opt.participant.profiles_file = next();
       else if (k == "--dds-participant-profile") opt.participant.profile = next();
+      else if (k == "--periods-log") opt.periods_log = next();
+      else if (k == "--process-faults") opt.process_faults = true;
+      else if (k == "--incarnation") {
+        const std::string v = next();
+        char* end = nullptr;
+        const unsigned long n = std::strtoul(v.c_str(), &end, 10);
+        if (v.empty() || *end != '\0' || n > 1000) throw std::invalid_argument("--incarnation must be 0..1000, got '" + v + "'");
+        opt.incarnation = static_cast<std::uint32_t>(n);
+      } else if (k == "--resume-at") {
+        const std::string v = next();
+        char* end = nullptr;
+        opt.resume_at_s = std::strtod(v.c_str(), &end);
+        if (v.empty() || *end != '\0' || !(opt.resume_at_s >= 0.0)) throw std::invalid_argument("--resume-at must be seconds >= 0, got '" + v + "'");
+      }
       else if (k == "-h" || k == "--help") { std::cout << kUsage; return 0; }
       else throw std::invalid_argument("unknown argument '" + k + "'");
     }
@@ -102,7 +104,9 @@ int main(int argc, char** argv) {
   // Config is loaded and validated before any DDS entity exists.
   std::optional<bbw::scenario::Scenario> scenario;
   try {
-    scenario = bbw::scenario::load_scenario(scenario_file);
+    auto fs = bbw::faults::load_fault_scenario(scenario_file);
+    scenario = std::move(fs.scenario);
+    opt.schedule = std::move(fs.faults);
     bool found = false;
     for (std::size_t i = 0; i < scenario->corners.size(); ++i) {
       if (scenario->corners[i].name == corner_arg) {
@@ -127,7 +131,7 @@ int main(int argc, char** argv) {
     std::cout << "bbw_corner " << corner_arg << ": domain " << opt.participant.domain_id << ", mode " << mode
               << ", scenario " << scenario->name << std::endl;
     rc = app.run(error);
-    if (!opt.stats_file.empty()) write_stats(opt.stats_file, corner_arg.c_str(), app.stats());
+    if (!opt.stats_file.empty()) app.write_stats(opt.stats_file);
     std::cout << "bbw_corner " << corner_arg << ": " << app.stats().periods << " periods, "
               << app.stats().samples_published << " samples published" << std::endl;
   } catch (const std::invalid_argument& e) {

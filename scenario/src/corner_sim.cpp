@@ -132,4 +132,11 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
   return sample_;
 }
 
+void CornerSim::start_at(double time_s) {
+  if (seq_ != 0) throw std::logic_error("CornerSim::start_at after the first step");
+  if (!std::isfinite(time_s) || time_s < 0.0) throw std::invalid_argument("CornerSim::start_at: time must be finite and >= 0");
+  time_s_ = time_s;
+  sample_.time_s = time_s;
+}
+
 }  // namespace bbw::scenario

@@ -107,6 +107,7 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
     if (monitor_.ok(Part::Resolver)) last_friction_kN_ = e.friction_kN;
   }
   refresh_view(check.usable() ? &r : nullptr, &check, fed);
+  last_estimate_ = fed != nullptr ? e : calibration::Estimate{};
   return view_;
 }
 

@@ -131,6 +131,13 @@ std::optional<ExitStatus> Child::wait_until(Clock::time_point deadline) {
   }
 }
 
+bool Child::take_stop() {
+  if (status_) return false;
+  siginfo_t si{};
+  if (::waitid(P_PID, static_cast<id_t>(pid_), &si, WSTOPPED | WNOHANG) != 0) return false;
+  return si.si_pid == pid_ && si.si_code == CLD_STOPPED;
+}
+
 void Child::send_signal(int sig) {
   if (!poll()) ::kill(pid_, sig);
 }

@@ -8,6 +8,14 @@
 // writes DIR/summary.json and DIR/report.html. If a process dies or fails (discovery timeout,
 // lost peer), the others are stopped and the launcher exits non-zero naming the process and
 // the reason. Exit: 0 ok, 1 a process failed or the run exceeded its bound, 2 bad arguments.
+//
+// Process faults of the scenario's schedule (docs/faults.md) are carried out here: a process
+// freezes itself (SIGSTOP) at its scheduled kill time (lockstep: the period; realtime: its wall
+// clock), the launcher SIGKILLs it at once and, if asked, starts a new incarnation of a corner
+// (lockstep: at once, the CCU holds the clock at the restart period until it has joined;
+// realtime: restart_after_s of wall time later). A scheduled kill is not a failure: after a CCU
+// kill the corners run to the end in their safe state and the run is reported as ended by the
+// injected fault. Any other death is an error naming the process.
 #include <signal.h>
 #include <sys/stat.h>
 
@@ -16,7 +24,9 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -24,10 +34,13 @@
 #include "bbw/common/json.hpp"
 #include "bbw/dds/domain.hpp"
 #include "bbw/dds/shm_cleanup.hpp"
+#include "bbw/faults/link_faults.hpp"
+#include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/launch/child.hpp"
 #include "bbw/launch/signals.hpp"
 #include "bbw/launch/stats_file.hpp"
 #include "bbw/scenario/load.hpp"
+#include "fault_report.hpp"
 #include "report.hpp"
 #include "summary.hpp"
 
@@ -110,8 +123,16 @@ int main(int argc, char** argv) {
 
   // Validate the scenario before starting anything.
   std::optional<bbw::scenario::Scenario> scenario;
+  bbw::faults::FaultSchedule schedule;
   try {
-    scenario = bbw::scenario::load_scenario(scenario_file);
+    auto fs = bbw::faults::load_fault_scenario(scenario_file);
+    scenario = std::move(fs.scenario);
+    schedule = std::move(fs.faults);
+    for (const auto& a : bbw::faults::process_actions(schedule)) {
+      if (a.target == bbw::faults::Target::CCU && a.kind == bbw::faults::ProcessAction::Kind::Restart) {
+        throw std::invalid_argument(scenario_file + ": restarting the CCU is not supported over DDS (a kill of the CCU ends the run)");
+      }
+    }
   } catch (const std::exception& e) {
     std::cerr << "bbw_launch: " << e.what() << "\n";
     return 2;
@@ -135,60 +156,143 @@ int main(int argc, char** argv) {
   const std::string dom = std::to_string(domain);
   const std::string disc = std::to_string(discovery_s);
   const auto wall0 = Clock::now();
-  try {
-    children.push_back(std::make_unique<Child>(
-        "bbw_ccu",
-        std::vector<std::string>{bin + "/bbw_ccu", "--scenario", scenario_file, "--domain", dom, "--mode", mode,
-                                 "--out", out_dir, "--discovery-timeout", disc, "--friction-feedback", feedback},
-        out_dir + "/ccu.out", out_dir + "/ccu.err"));
-    for (const auto& c : scenario->corners) {
-      children.push_back(std::make_unique<Child>(
-          "bbw_corner " + c.name,
-          std::vector<std::string>{corner_bin, "--corner", c.name, "--scenario", scenario_file, "--domain",
-                                   dom, "--mode", mode, "--stats", out_dir + "/corner_" + c.name + ".stats",
-                                   "--discovery-timeout", disc},
-          out_dir + "/corner_" + c.name + ".out", out_dir + "/corner_" + c.name + ".err"));
+  const auto actions = bbw::faults::process_actions(schedule);
+  const bool process_faults = !actions.empty();
+  // Where each corner's incarnations keep their stats and per-period log.
+  auto corner_stats_file = [&](const std::string& c, unsigned n) {
+    return out_dir + "/corner_" + c + (n == 0 ? "" : "." + std::to_string(n)) + ".stats";
+  };
+  std::map<std::string, unsigned> incarnations;  // corner -> processes started
+  auto spawn_corner = [&](const std::string& c, unsigned incarnation, double resume_at_s) {
+    std::vector<std::string> argv{corner_bin, "--corner", c, "--scenario", scenario_file, "--domain", dom,
+                                  "--mode", mode, "--stats", corner_stats_file(c, incarnation),
+                                  "--periods-log", out_dir + "/corner_" + c + "_periods.csv",
+                                  "--discovery-timeout", disc};
+    if (process_faults) argv.push_back("--process-faults");
+    if (incarnation > 0) {
+      argv.insert(argv.end(), {"--incarnation", std::to_string(incarnation), "--resume-at", std::to_string(resume_at_s)});
     }
+    const std::string suffix = incarnation == 0 ? "" : "." + std::to_string(incarnation);
+    children.push_back(std::make_unique<Child>("bbw_corner " + c + suffix, argv,
+                                               out_dir + "/corner_" + c + suffix + ".out",
+                                               out_dir + "/corner_" + c + suffix + ".err"));
+    incarnations[c] = incarnation + 1;
+  };
+  try {
+    std::vector<std::string> ccu_argv{bin + "/bbw_ccu", "--scenario", scenario_file, "--domain", dom, "--mode", mode,
+                                      "--out", out_dir, "--discovery-timeout", disc, "--friction-feedback", feedback};
+    if (process_faults) ccu_argv.push_back("--process-faults");
+    children.push_back(std::make_unique<Child>("bbw_ccu", ccu_argv, out_dir + "/ccu.out", out_dir + "/ccu.err"));
+    for (const auto& c : scenario->corners) spawn_corner(c.name, 0, 0.0);
   } catch (const std::exception& e) {
     std::cerr << "bbw_launch: " << e.what() << "\n";
     for (auto& c : children) c->stop(2000ms);
     return 1;
   }
   std::cout << "bbw_launch: " << scenario->name << ", " << mode << ", domain " << domain << ", "
-            << children.size() << " processes, discovery deadline " << discovery_s << " s" << std::endl;
+            << children.size() << " processes, discovery deadline " << discovery_s << " s"
+            << (process_faults ? ", process faults scheduled" : "") << std::endl;
 
-  // Bound on the whole run: discovery plus a generous multiple of the simulated duration.
-  const double bound_s = discovery_s + (mode == "lockstep" ? 10.0 * scenario->duration_s + 60.0
-                                                           : 1.5 * scenario->duration_s + 20.0);
+  // Bound on the whole run: discovery plus a generous multiple of the simulated duration (and
+  // one more discovery per scheduled restart).
+  std::size_t restarts_planned = 0;
+  for (const auto& a : actions) restarts_planned += a.kind == bbw::faults::ProcessAction::Kind::Restart ? 1 : 0;
+  const double bound_s = discovery_s * static_cast<double>(1 + restarts_planned) +
+                         (mode == "lockstep" ? 10.0 * scenario->duration_s + 60.0 : 1.5 * scenario->duration_s + 20.0);
   const auto deadline = wall0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(bound_s));
-  std::vector<Child*> raw;
-  for (auto& c : children) raw.push_back(c.get());
+  // Scheduled kills not yet carried out, per process name; restarts waiting for their time.
+  std::map<std::string, std::vector<const bbw::faults::ProcessAction*>> kills_due;
+  for (const auto& a : actions) {
+    if (a.kind == bbw::faults::ProcessAction::Kind::Kill) {
+      kills_due[a.target == bbw::faults::Target::CCU ? std::string("bbw_ccu") : std::string(bbw::faults::to_string(a.target))]
+          .push_back(&a);
+    }
+  }
+  struct PendingRestart {
+    std::string corner;
+    double resume_at_s;
+    Clock::time_point when;
+  };
+  std::vector<PendingRestart> restarts;
+  std::set<const Child*> killed_by_schedule, handled;
+  bool ccu_killed = false;
+  double ccu_killed_at_s = -1.0;
   std::string failure;
-  std::size_t finished = 0;
-  while (finished < raw.size()) {
-    // Wake at least every 200 ms to notice SIGINT/SIGTERM (the children get it from the
-    // terminal's process group too; this only bounds how long we take to stop them).
-    const auto wake = std::min(deadline, Clock::now() + 200ms);
-    const int i = bbw::launch::wait_any(raw, wake);
+  auto corner_of = [](const std::string& name) { return name.substr(11, 2); };  // "bbw_corner XX[.n]"
+  for (;;) {
+    // Scheduled kills need a quick look at stopped children; otherwise wake every 200 ms to
+    // notice SIGINT/SIGTERM (the children get it from the terminal's process group too).
+    const auto wake = std::min(deadline, Clock::now() + (process_faults ? 2ms : 200ms));
+    std::vector<Child*> raw;
+    for (auto& c : children) raw.push_back(c.get());
+    bbw::launch::wait_any(raw, wake);
     if (interrupted.load()) {
       failure = "interrupted by signal";
       break;
     }
-    if (i < 0) {
-      if (Clock::now() >= deadline) {
-        failure = "run exceeded its wall-time bound of " + std::to_string(static_cast<int>(bound_s)) + " s";
+    // A process that froze itself at its scheduled kill: kill it now.
+    for (auto& c : children) {
+      if (!c->take_stop()) continue;
+      const bool is_ccu = c->name() == "bbw_ccu";
+      auto& due = kills_due[is_ccu ? std::string("bbw_ccu") : corner_of(c->name())];
+      if (due.empty()) {
+        c->send_signal(SIGCONT);  // stopped by someone else: not ours to kill
+        continue;
+      }
+      const auto* kill = due.front();
+      due.erase(due.begin());
+      c->send_signal(SIGKILL);
+      c->wait_until(Clock::now() + 2000ms);
+      killed_by_schedule.insert(c.get());
+      std::cout << "bbw_launch: killed " << c->name() << " as scheduled at " << kill->at_s << " s" << std::endl;
+      if (is_ccu) {
+        ccu_killed = true;
+        ccu_killed_at_s = kill->at_s;
+        continue;
+      }
+      for (const auto& a : actions) {
+        if (a.kind == bbw::faults::ProcessAction::Kind::Restart && a.target == kill->target && a.at_s > kill->at_s) {
+          const double after_s = mode == "lockstep" ? 0.0 : a.at_s - kill->at_s;
+          restarts.push_back({corner_of(c->name()), a.at_s,
+                              Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(after_s))});
+          break;
+        }
+      }
+    }
+    for (auto it = restarts.begin(); it != restarts.end();) {
+      if (Clock::now() < it->when) {
+        ++it;
+        continue;
+      }
+      try {
+        spawn_corner(it->corner, incarnations[it->corner], it->resume_at_s);
+        std::cout << "bbw_launch: restarted corner " << it->corner << " to rejoin at " << it->resume_at_s << " s" << std::endl;
+      } catch (const std::exception& e) {
+        failure = "restart of corner " + it->corner + " failed: " + e.what();
+      }
+      it = restarts.erase(it);
+    }
+    if (!failure.empty()) break;
+    for (auto& c : children) {
+      if (!c->poll() || handled.count(c.get()) > 0) continue;
+      handled.insert(c.get());
+      if (killed_by_schedule.count(c.get()) > 0) continue;
+      const auto status = *c->status();
+      if (!status.ok()) {
+        const std::string name = c->name();
+        std::string err_file = out_dir + (name == "bbw_ccu" ? "/ccu.err" : "/corner_" + name.substr(11) + ".err");
+        failure = name + " failed: " + reason(status);
+        const std::string msg = last_line(err_file);
+        if (!msg.empty()) failure += ": " + msg;
         break;
       }
-      continue;
     }
-    ++finished;
-    const auto status = *raw[static_cast<std::size_t>(i)]->status();
-    if (!status.ok()) {
-      const std::string name = raw[static_cast<std::size_t>(i)]->name();
-      std::string err_file = out_dir + (name == "bbw_ccu" ? "/ccu.err" : "/corner_" + name.substr(11) + ".err");
-      failure = name + " failed: " + reason(status);
-      const std::string msg = last_line(err_file);
-      if (!msg.empty()) failure += ": " + msg;
+    if (!failure.empty()) break;
+    bool running = false;
+    for (auto& c : children) running = running || !c->poll();
+    if (!running && restarts.empty()) break;
+    if (Clock::now() >= deadline) {
+      failure = "run exceeded its wall-time bound of " + std::to_string(static_cast<int>(bound_s)) + " s";
       break;
     }
   }
@@ -196,6 +300,17 @@ int main(int argc, char** argv) {
     for (auto& c : children) c->stop(3000ms);
     std::cerr << "bbw_launch: " << failure << " (logs in " << out_dir << ")\n";
     return 1;
+  }
+  for (const auto& [name, due] : kills_due) {
+    if (!due.empty()) {
+      std::cerr << "bbw_launch: the scheduled kill of " << name << " at " << due.front()->at_s
+                << " s was never reached (the process finished first)\n";
+      return 1;
+    }
+  }
+  if (ccu_killed) {
+    std::cout << "bbw_launch: the run was ended by the injected CCU kill at " << ccu_killed_at_s
+              << " s; the corners ran on in their safe state" << std::endl;
   }
   const double launch_wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
 
@@ -210,28 +325,59 @@ int main(int argc, char** argv) {
     const double wall_s = num(ccu, "wall_s", ccu_stats_file);
     bbw::json::Writer j;
     std::vector<bbw::launch::ReportCorner> report_corners;
-    long long published = 0, received = 0, gaps = 0, overruns = 0, cmd_deadlines = 0;
+    long long published = 0, received = 0, gaps = 0, overruns = 0, cmd_deadlines = 0, in_flight_total = 0;
+    std::map<std::string, double> ccu_lost_s;
+    std::vector<std::vector<std::pair<double, double>>> period_logs;
     double max_jitter = 0.0;
     j.begin_object().value("scenario", scenario->name).value("scenario_file", scenario_file).value("mode", mode);
     j.value("domain", domain).value("friction_feedback", feedback);
     j.begin_array("corners");
     for (const auto& c : scenario->corners) {
-      const std::string cs_file = out_dir + "/corner_" + c.name + ".stats";
+      // Counters summed over the corner's incarnations (a restarted process has its own file).
+      const std::string cs_file = corner_stats_file(c.name, 0);
       const auto cs = bbw::launch::read_stats(cs_file);
+      auto corner_sum = [&](const std::string& key) {
+        double v = 0.0;
+        for (unsigned n = 0; n < incarnations[c.name]; ++n) {
+          const std::string f = corner_stats_file(c.name, n);
+          v += num(bbw::launch::read_stats(f), key, f);
+        }
+        return v;
+      };
+      auto corner_max = [&](const std::string& key) {
+        double v = 0.0;
+        for (unsigned n = 0; n < incarnations[c.name]; ++n) {
+          const std::string f = corner_stats_file(c.name, n);
+          v = std::max(v, num(bbw::launch::read_stats(f), key, f));
+        }
+        return v;
+      };
       const auto table = bbw::csv::read(out_dir + "/ccu_" + c.name + ".csv", bbw::launch::ccu_log_columns());
       const auto m = bbw::launch::summarize_corner(c.name, table);
       const std::string p = c.name + ".";
-      const long long pub = static_cast<long long>(num(cs, "samples_published", cs_file));
+      const long long pub = static_cast<long long>(corner_sum("samples_published"));
+      const long long in_flight = static_cast<long long>(corner_sum("samples_in_flight"));
       const long long rec = static_cast<long long>(num(ccu, p + "samples_received", ccu_stats_file));
       const long long g = static_cast<long long>(num(ccu, p + "sample_gaps", ccu_stats_file) +
                                                  num(ccu, p + "block_gaps", ccu_stats_file) +
-                                                 num(cs, "command_seq_gaps", cs_file));
+                                                 corner_sum("command_seq_gaps"));
       published += pub;
+      in_flight_total += in_flight;
       received += rec;
       gaps += g;
-      overruns += static_cast<long long>(num(cs, "overruns", cs_file));
-      cmd_deadlines += static_cast<long long>(num(cs, "command_deadlines_missed", cs_file));
-      max_jitter = std::max(max_jitter, num(cs, "max_jitter_s", cs_file));
+      overruns += static_cast<long long>(corner_sum("overruns"));
+      cmd_deadlines += static_cast<long long>(corner_sum("command_deadlines_missed"));
+      max_jitter = std::max(max_jitter, corner_max("max_jitter_s"));
+      ccu_lost_s[c.name] = num(bbw::launch::read_stats(corner_stats_file(c.name, incarnations[c.name] - 1)), "ccu_lost_s",
+                               corner_stats_file(c.name, incarnations[c.name] - 1));
+      std::vector<std::pair<double, double>> period_rows;
+      {
+        bbw::csv::ReadOptions o;
+        o.required = {"time_s", "force_true_kN"};
+        const auto t = bbw::csv::read(out_dir + "/corner_" + c.name + "_periods.csv", o);
+        for (std::size_t r = 0; r < t.rows(); ++r) period_rows.emplace_back(t.column("time_s")[r], t.column("force_true_kN")[r]);
+      }
+      period_logs.push_back(std::move(period_rows));
       j.begin_object()
           .value("corner", c.name)
           .value("temperature_C", c.conditions.temperature_C)
@@ -250,9 +396,19 @@ int main(int argc, char** argv) {
           .value("samples_published", pub)
           .value("samples_received", rec)
           .value("sequence_gaps", g)
-          .value("max_jitter_s", num(cs, "max_jitter_s", cs_file))
+          .value("samples_suppressed_by_fault", static_cast<long long>(corner_sum("samples_suppressed")))
+          .value("samples_in_flight_at_end", in_flight)
+          .value("incarnations", static_cast<long long>(incarnations[c.name]))
+          .value("rejoins", static_cast<long long>(num(ccu, p + "rejoins", ccu_stats_file)))
+          .value("samples_rejected_by_guard", static_cast<long long>(num(ccu, p + "guard_rejected", ccu_stats_file)))
+          .value("calibrator_restarts", static_cast<long long>(num(ccu, p + "calibrator_restarts", ccu_stats_file)))
+          .value("measurement_deadline_misses", static_cast<long long>(num(ccu, p + "deadlines_missed", ccu_stats_file)))
+          .value("measurement_liveliness_lost", static_cast<long long>(num(ccu, p + "liveliness_lost", ccu_stats_file)))
+          .value("command_deadline_misses", static_cast<long long>(corner_sum("command_deadlines_missed")))
+          .value("ccu_lost_detected_s", ccu_lost_s[c.name])
+          .value("max_jitter_s", corner_max("max_jitter_s"))
           .value("mean_jitter_s", num(cs, "mean_jitter_s", cs_file))
-          .value("overruns", static_cast<long long>(num(cs, "overruns", cs_file)))
+          .value("overruns", static_cast<long long>(corner_sum("overruns")))
           .end_object();
       bbw::launch::ReportCorner rc;
       rc.summary = m;
@@ -270,7 +426,8 @@ int main(int argc, char** argv) {
         .value("real_time_factor", wall_s > 0.0 ? sim_s / wall_s : 0.0)
         .value("samples_published", published)
         .value("samples_received", received)
-        .value("samples_lost", published - received)
+        .value("samples_lost", published - received - in_flight_total)
+        .value("ended_by_injected_ccu_kill", ccu_killed)
         .value("sequence_gaps", gaps)
         .value("measurement_deadline_misses", static_cast<long long>(num(ccu, "measurement_deadlines_missed", ccu_stats_file)))
         .value("measurement_liveliness_lost", static_cast<long long>(num(ccu, "measurement_liveliness_lost", ccu_stats_file)))
@@ -278,9 +435,51 @@ int main(int argc, char** argv) {
         .value("max_jitter_s", max_jitter)
         .value("overruns", overruns)
         .end_object();
+    // Injected faults against what was detected, and the total clamp force against demand.
+    const auto timeline = bbw::launch::build_timeline(*scenario, period_logs);
+    const auto detections = bbw::launch::read_detections(ccu, ccu_stats_file);
+    const auto faults = bbw::launch::assess_faults(schedule, detections, ccu_lost_s, timeline, scenario->duration_s);
+    j.begin_array("faults");
+    for (const auto& f : faults) {
+      j.begin_object()
+          .value("corner", std::string(bbw::faults::to_string(f.fault.target)))
+          .value("part", std::string(bbw::faults::to_string(f.fault.part)))
+          .value("type", std::string(bbw::faults::to_string(f.fault.type)))
+          .value("injected_s", f.fault.at_s)
+          .value("ends_s", std::min(f.fault.end_s(), scenario->duration_s))
+          .value("detected", f.detected)
+          .value("detected_s", f.detected ? f.detected_s : -1.0)
+          .value("latency_ms", f.detected ? f.latency_ms : -1.0)
+          .value("diagnosis", f.diagnosis)
+          .value("correct", f.correct)
+          .value("reaction", f.reaction)
+          .value("delivered_share", f.delivered_share)
+          .end_object();
+    }
+    j.end_array();
+    j.begin_array("detections");
+    for (const auto& d : detections) {
+      j.begin_object()
+          .value("corner", d.corner)
+          .value("part", d.part)
+          .value("finding", d.finding)
+          .value("onset_s", d.onset_s)
+          .value("detected_s", d.detected_s)
+          .end_object();
+    }
+    j.end_array();
     j.end_object();
     j.save(out_dir + "/summary.json");
-    if (report) bbw::launch::write_report(out_dir, "bbw run: " + scenario->name + " (" + mode + ")", report_corners, j.str());
+    {
+      std::ofstream tl(out_dir + "/timeline.csv");
+      tl << "time_s,demand_total_kN,delivered_total_kN\n";
+      for (const auto& p : timeline) tl << p.time_s << ',' << p.demand_kN << ',' << p.delivered_kN << '\n';
+      if (!tl) throw std::runtime_error(out_dir + "/timeline.csv: cannot write");
+    }
+    if (report) {
+      bbw::launch::write_report(out_dir, "bbw run: " + scenario->name + " (" + mode + ")", report_corners, j.str(),
+                                &faults, &detections);
+    }
     std::cout << "bbw_launch: done: simulated " << sim_s << " s in " << wall_s << " s (real-time factor "
               << (wall_s > 0 ? sim_s / wall_s : 0.0) << "), samples published " << published << ", received "
               << received << ", gaps " << gaps << "; " << out_dir << "/summary.json" << std::endl;

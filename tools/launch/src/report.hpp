@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "fault_report.hpp"
 #include "summary.hpp"
 
 namespace bbw::launch {
@@ -18,8 +19,11 @@ struct ReportCorner {
   bool calibrated = false;
 };
 
-// Throws std::runtime_error when gnuplot fails (the message names the script).
+// Throws std::runtime_error when gnuplot fails (the message names the script). With `faults`,
+// the report also shows the total clamp force against demand (DIR/timeline.csv) with the
+// injections and detections marked, and the fault table.
 void write_report(const std::string& dir, const std::string& title, const std::vector<ReportCorner>& corners,
-                  const std::string& summary_json);
+                  const std::string& summary_json, const std::vector<FaultResult>* faults = nullptr,
+                  const std::vector<Detection>* detections = nullptr);
 
 }  // namespace bbw::launch

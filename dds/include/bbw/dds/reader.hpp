@@ -7,8 +7,11 @@
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
+#include <array>
 #include <atomic>
 #include <chrono>
+#include <cstddef>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -22,6 +25,16 @@ struct ContentFilter {
   std::string filtered_topic_name;  // unique per participant, e.g. "ClampCommand_FL"
   std::string expression;           // DDS-SQL, e.g. "corner_id = %0"
   std::vector<std::string> parameters;
+};
+
+// A QoS event with the instance (deadline) or writer (liveliness) it concerns, queued by the
+// listener thread for the owner's main loop (per-corner fault detection, issue 5).
+struct QosEvent {
+  enum class Kind { DeadlineMissed, LivelinessLost, LivelinessRecovered };
+  Kind kind = Kind::DeadlineMissed;
+  // DeadlineMissed: the instance (key) that missed; liveliness: the writer (publication handle).
+  eprosima::fastrtps::rtps::InstanceHandle_t handle;
+  std::chrono::steady_clock::time_point at;
 };
 
 template <class PubSubT>
@@ -64,6 +77,29 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
     return false;
   }
 
+  // As take(), also returning the sample's info (instance and publication handles).
+  bool take(Type& out, eprosima::fastdds::dds::SampleInfo& info) {
+    while (reader_->take_next_sample(&out, &info) == ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data) {
+        taken_.fetch_add(1);
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // The oldest queued QoS event; false when none. Events beyond the queue's capacity (64) are
+  // dropped and counted (events_dropped()).
+  bool take_event(QosEvent& out) {
+    std::lock_guard<std::mutex> lock(event_mutex_);
+    if (event_count_ == 0) return false;
+    out = event_queue_[event_head_];
+    event_head_ = (event_head_ + 1) % event_queue_.size();
+    --event_count_;
+    return true;
+  }
+  std::uint64_t events_dropped() const { return events_dropped_.load(); }
+
   int matched() const { return matched_.load(); }
   std::uint64_t taken() const { return taken_.load(); }
   std::uint64_t deadlines_missed() const { return deadlines_missed_.load(); }
@@ -88,8 +124,9 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
   }
   void on_requested_deadline_missed(
       eprosima::fastdds::dds::DataReader*,
-      const eprosima::fastdds::dds::RequestedDeadlineMissedStatus&) override {
+      const eprosima::fastdds::dds::RequestedDeadlineMissedStatus& s) override {
     deadlines_missed_.fetch_add(1);
+    push_event(QosEvent::Kind::DeadlineMissed, s.last_instance_handle);
     events_.notify();
   }
   void on_liveliness_changed(eprosima::fastdds::dds::DataReader*,
@@ -97,6 +134,9 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
     alive_writers_.store(s.alive_count);
     if (s.not_alive_count_change > 0) {
       liveliness_lost_.fetch_add(static_cast<std::uint64_t>(s.not_alive_count_change));
+      push_event(QosEvent::Kind::LivelinessLost, s.last_publication_handle);
+    } else if (s.alive_count_change > 0) {
+      push_event(QosEvent::Kind::LivelinessRecovered, s.last_publication_handle);
     }
     events_.notify();
   }
@@ -117,8 +157,26 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
     events_.notify();
   }
 
+  void push_event(QosEvent::Kind kind, const eprosima::fastrtps::rtps::InstanceHandle_t& handle) {
+    std::lock_guard<std::mutex> lock(event_mutex_);
+    if (event_count_ == event_queue_.size()) {
+      events_dropped_.fetch_add(1);
+      return;
+    }
+    QosEvent& e = event_queue_[(event_head_ + event_count_) % event_queue_.size()];
+    e.kind = kind;
+    e.handle = handle;
+    e.at = std::chrono::steady_clock::now();
+    ++event_count_;
+  }
+
   Participant& participant_;
   Events& events_;
+  std::mutex event_mutex_;
+  std::array<QosEvent, 64> event_queue_{};
+  std::size_t event_head_ = 0;
+  std::size_t event_count_ = 0;
+  std::atomic<std::uint64_t> events_dropped_{0};
   eprosima::fastdds::dds::DataReader* reader_ = nullptr;
   std::atomic<int> matched_{0};
   std::atomic<int> alive_writers_{0};

@@ -82,6 +82,11 @@ class CornerSim {
   // Advances by dt_s and returns the new sample. Allocation-free.
   const CornerSample& step(double dt_s, const ExternalInputs& ext = {});
 
+  // Starts the corner's clock at time_s instead of 0 (a corner process restarted mid-run joins
+  // the scenario's time base; issue 5). Only before the first step; the plant is at its
+  // initial (released) state and the sequence starts at 1.
+  void start_at(double time_s);
+
   const CornerSample& last() const { return sample_; }
   const std::string& name() const { return name_; }
   const plant::Plant& plant() const { return plant_; }

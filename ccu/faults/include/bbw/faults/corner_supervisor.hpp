@@ -52,6 +52,9 @@ class CornerSupervisor {
   const CornerView& tick(double now_s);
 
   const CornerView& view() const { return view_; }
+  // The calibrator's output for the last sample given to on_sample (valid == false when the
+  // calibrator was not fed it: corrupt sample, missing load cell, faulty sensor, rejoin).
+  const calibration::Estimate& last_estimate() const { return last_estimate_; }
   const calibration::Calibrator& calibrator() const { return *calibrator_; }
   const FaultMonitor& monitor() const { return monitor_; }
   const SampleGuard& guard() const { return guard_; }
@@ -76,6 +79,7 @@ class CornerSupervisor {
   FaultMonitor monitor_;
   LastGoodCalibration last_good_;
   CornerView view_;
+  calibration::Estimate last_estimate_;
   bool load_cell_reacted_ = false;
   bool resolver_reacted_ = false;
   calibration::Curve trusted_curve_;

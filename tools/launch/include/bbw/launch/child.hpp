@@ -43,6 +43,9 @@ class Child {
   // Waits until the child exits or the deadline passes.
   std::optional<ExitStatus> wait_until(Clock::time_point deadline);
   void send_signal(int sig);
+  // True once when the child has stopped (SIGSTOP) since the last call; never blocks. A child
+  // that freezes itself this way asks to be killed at that instant (scheduled process faults).
+  bool take_stop();
   // SIGTERM, then SIGKILL if it has not exited after `grace`. Returns the exit status.
   ExitStatus stop(std::chrono::milliseconds grace);
 

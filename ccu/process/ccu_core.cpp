@@ -1,0 +1,123 @@
+#include "ccu_core.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace bbw::ccu {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::optional<std::size_t> slot_of(const std::string& name) {
+  const auto t = faults::target_from_name(name);
+  if (!t || *t == faults::Target::CCU) return std::nullopt;
+  return faults::corner_slot(*t);
+}
+
+}  // namespace
+
+faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, faults::MonitorParams base) {
+  const auto act = scenario::actuator_model(scenario.plant);
+  base.torque_per_A_Nm = act.torque_per_A_Nm;
+  base.Nm_per_kN = act.Nm_per_kN;
+  base.inertia_kg_m2 = act.inertia_kg_m2;
+  return base;
+}
+
+CcuCore::CcuCore(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator,
+                 double fusion_weight, const faults::MonitorParams& monitor)
+    : scenario_(scenario), planner_(scenario), fusion_weight_(fusion_weight) {
+  if (!(fusion_weight >= 0.0 && fusion_weight <= 1.0)) throw std::invalid_argument("fusion weight must be in [0, 1]");
+  const faults::MonitorParams mp = monitor_params_for(scenario, monitor);
+  for (std::size_t i = 0; i < scenario.corners.size(); ++i) {
+    const auto slot = slot_of(scenario.corners[i].name);
+    if (!slot) {
+      throw std::invalid_argument(scenario.file + ": corner '" + scenario.corners[i].name +
+                                  "' cannot run over DDS (names must be FL, FR, RL or RR)");
+    }
+    if (supervisors_[*slot]) {
+      throw std::invalid_argument(scenario.file + ": corner " + scenario.corners[i].name + " appears twice");
+    }
+    supervisors_[*slot] = std::make_unique<faults::CornerSupervisor>(
+        calibrator, mp, static_cast<faults::Target>(*slot));
+    scenario_index_[*slot] = i;
+  }
+  if (scenario.corners.empty()) throw std::invalid_argument(scenario.file + ": no corners");
+  if (scenario.demand) redistributor_.emplace(scenario.demand->front_share);
+}
+
+const SampleOutcome& CcuCore::on_sample(std::size_t slot, const faults::CornerReading& r, double arrival_s) {
+  faults::CornerSupervisor& sup = *supervisors_[slot];
+  const faults::CornerView& v = sup.on_sample(r, arrival_s);
+  const calibration::Estimate& e = sup.last_estimate();
+  SampleOutcome& o = outcome_;
+  o.calibrated = sup.calibrator().stats().fits_accepted > 0;
+  if (e.valid && v.source == faults::EstimateSource::Calibrator) {
+    o.estimate_kN = e.force_kN;
+    o.friction_kN = e.friction_kN;
+    o.curve_kN = e.curve_force_kN;
+    o.fused_kN = fuse(e, r.load_cell_kN, fusion_weight_);
+    o.valid = true;
+    o.from_calibrator = true;
+  } else {
+    o.estimate_kN = v.force_estimate_kN;
+    o.friction_kN = kNaN;
+    o.curve_kN = v.curve.force_kN(r.position_rev);
+    o.fused_kN = v.force_estimate_kN;
+    o.valid = v.estimate_valid();
+    o.from_calibrator = false;
+  }
+  return o;
+}
+
+void CcuCore::on_link_event(std::size_t slot, faults::LinkEvent e, double time_s) {
+  if (supervisors_[slot]) supervisors_[slot]->on_link_event(e, time_s);
+}
+
+void CcuCore::tick(double now_s) {
+  for (auto& s : supervisors_) {
+    if (s) s->tick(now_s);
+  }
+}
+
+double CcuCore::demand_total_kN(double time_s) const {
+  double total = 0.0;
+  for (std::size_t i = 0; i < scenario_.corners.size(); ++i) {
+    const PlannedCommand p = planner_.at(i, time_s);
+    if (p.mode == CommandMode::Force) total += p.clamp_force_kN;
+  }
+  return total;
+}
+
+const std::array<CornerPlan, kSlots>& CcuCore::plan(double time_s) {
+  bool all_available = true;
+  std::array<faults::CornerCapacity, kSlots> cap{};
+  for (std::size_t s = 0; s < kSlots; ++s) {
+    CornerPlan& p = plans_[s];
+    if (!supervisors_[s]) {
+      cap[s] = {false, 0.0};
+      continue;
+    }
+    const faults::CornerView& v = supervisors_[s]->view();
+    const PlannedCommand nominal = planner_.at(scenario_index_[s], time_s);
+    p.mode = nominal.mode;
+    p.clamp_force_kN = nominal.clamp_force_kN;
+    p.available = v.available;
+    p.feedback = v.feedback;
+    p.curve = v.curve;
+    cap[s] = {v.available, v.force_limit_kN};
+    all_available = all_available && v.available;
+  }
+  if (!all_available && redistributor_) {
+    const faults::Allocation a = redistributor_->allocate(demand_total_kN(time_s), cap);
+    for (std::size_t s = 0; s < kSlots; ++s) {
+      if (supervisors_[s] && plans_[s].mode == CommandMode::Force) plans_[s].clamp_force_kN = a.force_kN[s];
+    }
+  }
+  return plans_;
+}
+
+}  // namespace bbw::ccu

@@ -1,0 +1,83 @@
+// The CCU's per-sample and per-period logic without DDS (docs/distributed.md, docs/faults.md):
+// one CornerSupervisor per corner (sample guard, calibrator, fault monitor, reactions), the
+// fused clamp-force estimate, and the per-corner commands (the scenario's demand, shared by the
+// Redistributor when a corner is unavailable). Pure: time is an argument; per-sample calls do
+// not allocate (test_ccu_core_no_alloc), except a corner's rejoin, which rebuilds its calibrator.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <optional>
+
+#include "bbw/calibration/calibrator.hpp"
+#include "bbw/calibration/config.hpp"
+#include "bbw/faults/corner_supervisor.hpp"
+#include "bbw/faults/fault_monitor.hpp"
+#include "bbw/faults/redistributor.hpp"
+#include "bbw/scenario/scenario.hpp"
+#include "command_plan.hpp"
+
+namespace bbw::ccu {
+
+inline constexpr std::size_t kSlots = faults::kCorners;  // FL, FR, RL, RR
+
+// What the CCU concluded from one sample (logged per sample).
+struct SampleOutcome {
+  double estimate_kN = 0.0;   // calibrator: load cell minus friction; else the reaction's estimate
+  double friction_kN = 0.0;   // calibrator's friction estimate (NaN when it was not fed)
+  double curve_kN = 0.0;      // the trusted curve at the sample's position
+  double fused_kN = 0.0;      // the CCU's clamp-force estimate
+  bool valid = false;         // an estimate exists
+  bool calibrated = false;    // the corner's calibrator has accepted a fit
+  bool from_calibrator = false;
+};
+
+// The command for one corner and period.
+struct CornerPlan {
+  CommandMode mode = CommandMode::Profile;
+  double clamp_force_kN = 0.0;
+  bool available = true;
+  std::optional<corner_unit::ForceFeedback> feedback;  // reaction override, if any
+  calibration::Curve curve;                            // for feedback == Curve
+};
+
+class CcuCore {
+ public:
+  // Throws std::invalid_argument (corner names not FL/FR/RL/RR, twice, bad configs).
+  CcuCore(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator,
+          double fusion_weight, const faults::MonitorParams& monitor = {});
+
+  bool has(std::size_t slot) const { return supervisors_[slot] != nullptr; }
+  // The scenario index of the corner in `slot`.
+  std::size_t scenario_index(std::size_t slot) const { return scenario_index_[slot]; }
+
+  const SampleOutcome& on_sample(std::size_t slot, const faults::CornerReading& r, double arrival_s);
+  void on_link_event(std::size_t slot, faults::LinkEvent e, double time_s);
+  void tick(double now_s);
+  // Commands for the period starting at time_s. With every corner available this is the
+  // scenario's nominal split (CommandPlanner); otherwise the Redistributor shares the nominal
+  // total among the available corners.
+  const std::array<CornerPlan, kSlots>& plan(double time_s);
+  // The demanded total clamp force at time_s (sum of the nominal commands), kN.
+  double demand_total_kN(double time_s) const;
+
+  const faults::CornerSupervisor& supervisor(std::size_t slot) const { return *supervisors_[slot]; }
+  double fusion_weight() const { return fusion_weight_; }
+
+ private:
+  const scenario::Scenario& scenario_;
+  CommandPlanner planner_;
+  double fusion_weight_;
+  std::array<std::unique_ptr<faults::CornerSupervisor>, kSlots> supervisors_;
+  std::array<std::size_t, kSlots> scenario_index_{};
+  std::optional<faults::Redistributor> redistributor_;
+  std::array<CornerPlan, kSlots> plans_{};
+  SampleOutcome outcome_;
+};
+
+// The monitor's actuator model from the scenario's plant (torque per ampere, load torque per
+// kN, inertia); everything else from `base`.
+faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, faults::MonitorParams base = {});
+
+}  // namespace bbw::ccu

@@ -1,0 +1,54 @@
+// The `faults` part of a run's summary (docs/faults.md, "Reporting"): each injected fault against
+// the detections the CCU logged (ccu.stats) or, for a CCU kill, the corners' watchdogs; and the
+// total clamp force against the demand (corner_<C>_periods.csv). Pure arithmetic over what the
+// launcher read.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "bbw/faults/schedule.hpp"
+#include "bbw/scenario/scenario.hpp"
+
+namespace bbw::launch {
+
+struct Detection {
+  std::string corner;   // FL, FR, RL, RR
+  std::string finding;  // faults::to_string(Finding)
+  std::string part;     // faults::to_string(Part)
+  double onset_s = 0.0;
+  double detected_s = 0.0;
+};
+
+// The detection.N.* keys of ccu.stats (none when the file has no such keys).
+std::vector<Detection> read_detections(const std::map<std::string, std::string>& ccu_stats, const std::string& file);
+
+struct TimelinePoint {
+  double time_s = 0.0;          // end of the period
+  double demand_kN = 0.0;       // demanded total clamp force (the scenario's nominal split)
+  double delivered_kN = 0.0;    // sum of the corners' true clamp forces (a dead corner: 0)
+};
+
+// One point per CCU period. `period_logs`: per corner, the rows (time_s, force_true_kN) of its
+// corner_<C>_periods.csv, all incarnations.
+std::vector<TimelinePoint> build_timeline(const scenario::Scenario& s,
+                                          const std::vector<std::vector<std::pair<double, double>>>& period_logs);
+
+struct FaultResult {
+  faults::FaultSpec fault;
+  bool detected = false;
+  double detected_s = 0.0;
+  double latency_ms = 0.0;
+  std::string diagnosis = "none";
+  bool correct = false;
+  std::string reaction = "none";
+  double delivered_share = 1.0;  // delivered / demanded total while the fault lasted
+};
+
+// ccu_lost_s: per corner, the simulated time its watchdog found the CCU lost (< 0: never).
+std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, const std::vector<Detection>& detections,
+                                       const std::map<std::string, double>& ccu_lost_s,
+                                       const std::vector<TimelinePoint>& timeline, double run_end_s);
+
+}  // namespace bbw::launch
