@@ -1,27 +1,13 @@
 // Counts heap allocations across a long per-sample run: there must be none after construction.
 #include <gtest/gtest.h>
 
-#include <atomic>
+#include "alloc_counter.hpp"
+
 #include <cstdlib>
-#include <new>
 
 #include "bbw/calibration/calibrator.hpp"
 #include "synthetic.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}
-
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 using namespace bbw::calibration;
 
@@ -40,12 +26,12 @@ TEST(CalibratorAllocation, NoHeapAllocationPerSample) {
     for (double d : truth.delta_rev) truth.k_kN_per_rev.push_back(0.1 / d);
     const auto rec = test::synthetic_recording(truth, 0.03, 9);
     Calibrator cal(c);
-    const long before = g_allocations.load();
+    const long before = bbw::test::allocation_count();
     double sink = 0.0;
     for (std::size_t k = 0; k < rec.time_s.size(); ++k) {
       sink += cal.update({rec.time_s[k], rec.position_rev[k], rec.force_kN[k]}).force_kN;
     }
-    const long after = g_allocations.load();
+    const long after = bbw::test::allocation_count();
     EXPECT_EQ(after - before, 0) << "mode " << to_string(mode);
     EXPECT_GE(cal.stats().fits_accepted, 8u);  // the run did exercise the cycle-end fits
     EXPECT_TRUE(std::isfinite(sink));

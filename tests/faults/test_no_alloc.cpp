@@ -3,9 +3,9 @@
 // Redistributor, over a run with a load-cell fault being detected and reacted to.
 #include <gtest/gtest.h>
 
-#include <atomic>
+#include "alloc_counter.hpp"
+
 #include <cstdlib>
-#include <new>
 
 #include "bbw/faults/ccu_watchdog.hpp"
 #include "bbw/faults/corner_supervisor.hpp"
@@ -13,20 +13,6 @@
 #include "bbw/faults/redistributor.hpp"
 #include "closed_loop.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}
-
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 using namespace bbw::faults;
 
@@ -41,7 +27,7 @@ TEST(FaultAllocation, NoHeapAllocationPerSample) {
   CornerSupervisor sup(options.calibrator, options.monitor, Target::FL);
   const Redistributor redistributor(0.6);
   std::array<CornerCapacity, kCorners> cap{};
-  const long before = g_allocations.load();
+  const long before = bbw::test::allocation_count();
   double sum = 0.0;
   for (int k = 0; k < 14000; ++k) {
     const double t = sim.time_s() + 0.001;
@@ -64,7 +50,7 @@ TEST(FaultAllocation, NoHeapAllocationPerSample) {
     cap[0] = {v.available, v.force_limit_kN};
     sum += redistributor.allocate(66.0, cap).total_kN;
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(bbw::test::allocation_count() - before, 0);
   EXPECT_GT(sum, 0.0);
   EXPECT_FALSE(sup.monitor().ok(Part::LoadCell));  // the bias at 11 s was found and reacted to
 }
