@@ -301,7 +301,8 @@ void CcuApp::drain_qos_events(double now_s, bool lockstep) {
       if (e.kind == dds::QosEvent::Kind::DeadlineMissed && e.handle == ch.instance) {
         ++ch.deadlines_missed;
         if (!lockstep) core_.on_link_event(ch.slot, faults::LinkEvent::DeadlineMissed, t);
-      } else if (e.kind == dds::QosEvent::Kind::LivelinessLost && e.handle == ch.writer) {
+      } else if ((e.kind == dds::QosEvent::Kind::LivelinessLost || e.kind == dds::QosEvent::Kind::WriterLost) &&
+                 e.handle == ch.writer && ch.writer_alive) {
         ++ch.liveliness_lost;
         ch.writer_alive = false;
         if (!lockstep) core_.on_link_event(ch.slot, faults::LinkEvent::LivelinessLost, t);

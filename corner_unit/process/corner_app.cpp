@@ -124,7 +124,9 @@ double CornerApp::sim_now_s() const {
          std::chrono::duration<double>(Clock::now() - t0_).count();
 }
 
-bool CornerApp::ccu_gone() const { return commands_.liveliness_lost() > 0 && commands_.alive_writers() == 0; }
+bool CornerApp::ccu_gone() const {
+  return (commands_.liveliness_lost() > 0 && commands_.alive_writers() == 0) || commands_.matched() == 0;
+}
 
 // Takes every waiting command and calibration state; keeps the newest command.
 void CornerApp::drain_inputs() {
@@ -234,6 +236,9 @@ void CornerApp::simulate_period(std::uint64_t k) {
     if (blocks_.write(block_)) {
       ++stats_.blocks_published;
       stats_.samples_published += block_.samples().size();
+      if (ccu_lost_ || w.mode == faults::WatchdogMode::Holding || w.mode == faults::WatchdogMode::Default) {
+        stats_.samples_without_ccu += block_.samples().size();
+      }
     } else {
       ++stats_.write_failures;
     }
@@ -365,6 +370,7 @@ void CornerApp::write_stats(const std::string& file) const {
   w.set("samples_suppressed", s.samples_suppressed);
   w.set("samples_delayed", s.samples_delayed);
   w.set("samples_in_flight", s.samples_in_flight);
+  w.set("samples_without_ccu", s.samples_without_ccu);
   w.set("ccu_lost_s", s.ccu_lost_s);
   w.set("default_force_s", s.default_force_s);
   w.set("wall_s", s.wall_s);

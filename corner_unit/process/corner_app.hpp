@@ -77,6 +77,7 @@ struct CornerStats {
   std::uint64_t samples_suppressed = 0;  // not sent: injected network silence
   std::uint64_t samples_delayed = 0;     // sent late: injected network delay
   std::uint64_t samples_in_flight = 0;   // still held back by a delay at the end
+  std::uint64_t samples_without_ccu = 0; // published while the CCU was lost (nobody to receive them)
   double ccu_lost_s = -1.0;              // simulated time the watchdog found the CCU lost (-1: never)
   double default_force_s = -1.0;         // ... and went to the default clamp force
   std::uint64_t first_step = 0;          // the period this incarnation started at

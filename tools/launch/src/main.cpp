@@ -356,7 +356,9 @@ int main(int argc, char** argv) {
       const auto m = bbw::launch::summarize_corner(c.name, table);
       const std::string p = c.name + ".";
       const long long pub = static_cast<long long>(corner_sum("samples_published"));
-      const long long in_flight = static_cast<long long>(corner_sum("samples_in_flight"));
+      // Not receivable: still held back by an injected delay, or sent after the CCU died.
+      const long long in_flight =
+          static_cast<long long>(corner_sum("samples_in_flight") + corner_sum("samples_without_ccu"));
       const long long rec = static_cast<long long>(num(ccu, p + "samples_received", ccu_stats_file));
       const long long g = static_cast<long long>(num(ccu, p + "sample_gaps", ccu_stats_file) +
                                                  num(ccu, p + "block_gaps", ccu_stats_file) +
@@ -397,7 +399,7 @@ int main(int argc, char** argv) {
           .value("samples_received", rec)
           .value("sequence_gaps", g)
           .value("samples_suppressed_by_fault", static_cast<long long>(corner_sum("samples_suppressed")))
-          .value("samples_in_flight_at_end", in_flight)
+          .value("samples_not_receivable", in_flight)
           .value("incarnations", static_cast<long long>(incarnations[c.name]))
           .value("rejoins", static_cast<long long>(num(ccu, p + "rejoins", ccu_stats_file)))
           .value("samples_rejected_by_guard", static_cast<long long>(num(ccu, p + "guard_rejected", ccu_stats_file)))

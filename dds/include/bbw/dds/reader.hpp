@@ -30,9 +30,12 @@ struct ContentFilter {
 // A QoS event with the instance (deadline) or writer (liveliness) it concerns, queued by the
 // listener thread for the owner's main loop (per-corner fault detection, issue 5).
 struct QosEvent {
-  enum class Kind { DeadlineMissed, LivelinessLost, LivelinessRecovered };
+  // WriterLost: a matched writer went away (its participant's discovery lease expired, or it
+  // was deleted). In Fast DDS 2.9 on this machine the liveliness-lost callback of a killed
+  // writer came late or never (docs/distributed.md), so the unmatch is the dependable signal.
+  enum class Kind { DeadlineMissed, LivelinessLost, LivelinessRecovered, WriterLost };
   Kind kind = Kind::DeadlineMissed;
-  // DeadlineMissed: the instance (key) that missed; liveliness: the writer (publication handle).
+  // DeadlineMissed: the instance (key) that missed; otherwise the writer (publication handle).
   eprosima::fastrtps::rtps::InstanceHandle_t handle;
   std::chrono::steady_clock::time_point at;
 };
@@ -120,6 +123,7 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
   void on_subscription_matched(eprosima::fastdds::dds::DataReader*,
                                const eprosima::fastdds::dds::SubscriptionMatchedStatus& s) override {
     matched_.store(s.current_count);
+    if (s.current_count_change < 0) push_event(QosEvent::Kind::WriterLost, s.last_publication_handle);
     events_.notify();
   }
   void on_requested_deadline_missed(
