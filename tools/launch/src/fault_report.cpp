@@ -98,8 +98,8 @@ std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, co
       }
       if (std::isfinite(first)) {
         r.detected = true;
-        r.detected_s = first;
-        r.latency_ms = 1e3 * (first - f.at_s);
+        r.detected_s = r.diagnosis_s = first;
+        r.latency_ms = r.diagnosis_latency_ms = 1e3 * (first - f.at_s);
         r.diagnosis = "ccu_lost";
         r.correct = all;
         r.reaction = "corners hold the last command, then ramp to the default clamp force (never release)";
@@ -110,8 +110,10 @@ std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, co
     const std::string corner = faults::to_string(f.target);
     const std::string expected = faults::to_string(f.type == faults::FaultType::Kill ? faults::Part::Process : f.part);
     const Detection* best = nullptr;
+    const Detection* first = nullptr;
     for (const Detection& d : detections) {
       if (d.corner != corner || d.detected_s < f.at_s - 1e-9) continue;
+      if (first == nullptr || d.detected_s < first->detected_s) first = &d;
       const bool right = d.part == expected;
       if (best == nullptr) {
         best = &d;
@@ -122,8 +124,10 @@ std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, co
     }
     if (best != nullptr) {
       r.detected = true;
-      r.detected_s = best->detected_s;
-      r.latency_ms = 1e3 * (best->detected_s - f.at_s);
+      r.detected_s = first->detected_s;
+      r.latency_ms = 1e3 * (first->detected_s - f.at_s);
+      r.diagnosis_s = best->detected_s;
+      r.diagnosis_latency_ms = 1e3 * (best->detected_s - f.at_s);
       r.diagnosis = best->finding;
       r.correct = best->part == expected;
       r.reaction = reaction_for(best->finding);

@@ -38,8 +38,10 @@ std::vector<TimelinePoint> build_timeline(const scenario::Scenario& s,
 struct FaultResult {
   faults::FaultSpec fault;
   bool detected = false;
-  double detected_s = 0.0;
-  double latency_ms = 0.0;
+  double detected_s = 0.0;        // first detection of anything on the faulty corner (CCU: first watchdog)
+  double latency_ms = 0.0;        // detected_s - injection
+  double diagnosis_s = 0.0;       // when the diagnosis below was made (the right part's, if any)
+  double diagnosis_latency_ms = 0.0;
   std::string diagnosis = "none";
   bool correct = false;
   std::string reaction = "none";

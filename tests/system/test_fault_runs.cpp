@@ -1,0 +1,227 @@
+// Fault campaigns over the real processes (bbw_launch -> bbw_ccu + four bbw_corner over Fast
+// DDS on loopback; docs/faults.md, "Over DDS"). Each test uses its own DDS domain id (noted per
+// test) so ctest -j runs them in parallel; every run is bounded by the launcher and here.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "bbw/common/csv.hpp"
+#include "bbw/launch/child.hpp"
+#include "bbw/launch/stats_file.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+
+std::string src(const std::string& rel) { return std::string(BBW_TEST_SOURCE_DIR) + "/" + rel; }
+std::string bin(const std::string& name) { return std::string(BBW_TEST_BINARY_DIR) + "/bin/" + name; }
+
+std::string slurp(const std::string& file) {
+  std::ifstream f(file);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+std::string scratch(const std::string& test) {
+  const fs::path p = fs::temp_directory_path() / ("bbw_faults_" + test + "_" + std::to_string(::getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+struct LaunchRun {
+  bbw::launch::ExitStatus status;
+  std::string out, err, dir;
+};
+
+LaunchRun launch(const std::string& scenario, const std::string& dir, int domain, const std::string& mode) {
+  bbw::launch::Child child("bbw_launch",
+                           {bin("bbw_launch"), src(scenario), "--out", dir + "/out", "--mode", mode, "--domain",
+                            std::to_string(domain), "--discovery-timeout", "20", "--no-report"},
+                           dir + "/launch.stdout", dir + "/launch.stderr");
+  auto status = child.wait_until(std::chrono::steady_clock::now() + 170s);
+  if (!status) status = child.stop(2000ms);
+  return {*status, slurp(dir + "/launch.stdout"), slurp(dir + "/launch.stderr"), dir};
+}
+
+// A flat reading of summary.json's "faults" and "detections" arrays: one map per object, string
+// values unquoted. summary.json is written by our own writer, one key per line.
+std::vector<std::map<std::string, std::string>> objects(const std::string& json, const std::string& array) {
+  std::vector<std::map<std::string, std::string>> out;
+  const auto a = json.find("\"" + array + "\": [");
+  if (a == std::string::npos) return out;
+  const auto end = json.find(']', a);
+  std::size_t pos = a;
+  while (true) {
+    const auto open = json.find('{', pos);
+    if (open == std::string::npos || open > end) break;
+    const auto close = json.find('}', open);
+    std::map<std::string, std::string> m;
+    std::istringstream lines(json.substr(open + 1, close - open - 1));
+    std::string line;
+    while (std::getline(lines, line)) {
+      const auto q1 = line.find('"');
+      const auto q2 = line.find('"', q1 + 1);
+      const auto colon = line.find(':', q2);
+      if (q1 == std::string::npos || q2 == std::string::npos || colon == std::string::npos) continue;
+      std::string v = line.substr(colon + 1);
+      v.erase(0, v.find_first_not_of(' '));
+      while (!v.empty() && (v.back() == ',' || v.back() == ' ')) v.pop_back();
+      if (v.size() >= 2 && v.front() == '"') v = v.substr(1, v.size() - 2);
+      m[line.substr(q1 + 1, q2 - q1 - 1)] = v;
+    }
+    out.push_back(m);
+    pos = close + 1;
+  }
+  return out;
+}
+
+double num(const std::map<std::string, std::string>& m, const std::string& k) {
+  const auto it = m.find(k);
+  EXPECT_NE(it, m.end()) << "missing key " << k;
+  return it == m.end() ? 0.0 : std::stod(it->second);
+}
+
+struct Case {
+  friend void PrintTo(const Case& c, std::ostream* os) { *os << c.scenario << " on domain " << c.domain; }
+  const char* scenario;  // under config/scenarios/faults/
+  int domain;
+};
+
+class LockstepFault : public ::testing::TestWithParam<Case> {};
+
+// Domains 170-182: each fault type runs through the launcher in lockstep; every injected fault
+// is detected and diagnosed right, and nothing else is raised on any corner.
+TEST_P(LockstepFault, IsDetectedAndDiagnosedRight) {
+  const Case c = GetParam();
+  const std::string dir = scratch(c.scenario);
+  const LaunchRun r = launch("config/scenarios/faults/" + std::string(c.scenario) + ".yaml", dir, c.domain, "lockstep");
+  ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
+  const std::string summary = slurp(dir + "/out/summary.json");
+  const auto faults = objects(summary, "faults");
+  const auto detections = objects(summary, "detections");
+  ASSERT_FALSE(faults.empty()) << summary;
+  for (const auto& f : faults) {
+    EXPECT_EQ(f.at("detected"), "true") << f.at("corner") << " " << f.at("type");
+    EXPECT_EQ(f.at("correct"), "true") << f.at("corner") << " " << f.at("type") << ": diagnosis " << f.at("diagnosis");
+    EXPECT_GE(num(f, "latency_ms"), 0.0);
+    EXPECT_LT(num(f, "latency_ms"), 500.0) << f.at("type");  // drift is the slowest (~380 ms)
+    if (f.at("part") == "load_cell" && f.at("type") == "bias") EXPECT_LE(num(f, "latency_ms"), 100.0);
+    if (f.at("corner") == "CCU") continue;
+    for (const auto& d : detections) {
+      EXPECT_EQ(d.at("corner"), f.at("corner")) << "a fault raised on another corner: " << d.at("finding");
+    }
+  }
+  if (std::string(c.scenario) == "ccu_kill") {
+    EXPECT_NE(summary.find("\"ended_by_injected_ccu_kill\": true"), std::string::npos) << summary;
+    EXPECT_TRUE(detections.empty());
+    for (const auto& corner : objects(summary, "corners")) {
+      // Every corner's watchdog found the CCU lost 20 ms after its last command.
+      EXPECT_NEAR(num(corner, "ccu_lost_detected_s"), 11.016, 0.011) << corner.at("corner");
+    }
+    // The corners kept braking: the default clamp force (8 kN) each, never released.
+    bbw::csv::ReadOptions o;
+    o.required = {"time_s", "force_true_kN", "watchdog_mode"};
+    for (const char* k : {"FL", "FR", "RL", "RR"}) {
+      const auto t = bbw::csv::read(dir + "/out/corner_" + std::string(k) + "_periods.csv", o);
+      const auto& time = t.column("time_s");
+      const auto& f = t.column("force_true_kN");
+      const auto& mode = t.column("watchdog_mode");
+      ASSERT_NEAR(time.back(), 14.0, 1e-6) << k;
+      EXPECT_EQ(mode.back(), 3.0) << k << ": not in the default state at the end";
+      EXPECT_GT(f.back(), 6.0) << k << ": released after the CCU died";
+    }
+  }
+  if (std::string(c.scenario) == "process_kill") {
+    // The restart: RR's second process joined at 11.5 s; no sample lost or applied twice.
+    for (const auto& corner : objects(summary, "corners")) {
+      EXPECT_EQ(num(corner, "samples_published"), num(corner, "samples_received")) << corner.at("corner");
+      EXPECT_EQ(num(corner, "sequence_gaps"), 0.0) << corner.at("corner");
+      EXPECT_EQ(num(corner, "samples_rejected_by_guard"), 0.0) << corner.at("corner");
+    }
+    const std::string ccu = dir + "/out/ccu.stats";
+    const auto st = bbw::launch::read_stats(ccu);
+    EXPECT_EQ(bbw::launch::stat_number(st, "RR.rejoins", ccu), 1.0);
+    EXPECT_EQ(bbw::launch::stat_number(st, "RR.calibrator_restarts", ccu), 1.0);
+    // In the CCU's log every RR sample time appears once and in order; 11.0 s to 11.5 s is the
+    // dead time, and the new process counts from sequence 1 again.
+    bbw::csv::ReadOptions o;
+    o.required = {"time_s", "seq"};
+    const auto t = bbw::csv::read(dir + "/out/ccu_RR.csv", o);
+    const auto& time = t.column("time_s");
+    const auto& seq = t.column("seq");
+    ASSERT_EQ(t.rows(), 13500u);
+    int restarts = 0;
+    for (std::size_t i = 1; i < t.rows(); ++i) {
+      ASSERT_GT(time[i], time[i - 1]) << "row " << i;
+      if (seq[i] != seq[i - 1] + 1) {
+        ++restarts;
+        EXPECT_EQ(seq[i], 1.0);
+        EXPECT_NEAR(time[i - 1], 11.0, 1e-9);
+        EXPECT_NEAR(time[i], 11.501, 1e-9);
+      }
+    }
+    EXPECT_EQ(restarts, 1);
+  }
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EveryFaultType, LockstepFault,
+    ::testing::Values(Case{"load_cell_bias", 170}, Case{"load_cell_drift", 171}, Case{"load_cell_stuck", 172},
+                      Case{"load_cell_noise_burst", 173}, Case{"load_cell_dropout", 174}, Case{"resolver_offset", 175},
+                      Case{"resolver_stuck", 176}, Case{"actuator_torque_loss", 177}, Case{"actuator_total_loss", 178},
+                      Case{"network_silence", 179}, Case{"network_delay", 180}, Case{"process_kill", 181},
+                      Case{"ccu_kill", 182}),
+    [](const ::testing::TestParamInfo<Case>& i) { return std::string(i.param.scenario); });
+
+// Domains 183, 184: fault-free scenarios raise nothing over DDS either.
+TEST(SystemFaults, FaultFreeRunsRaiseNoFault) {
+  int domain = 183;
+  for (const char* s : {"config/scenarios/faults/fault_free_stop.yaml", "config/scenarios/vehicle_stop.yaml"}) {
+    const std::string dir = scratch("fault_free_" + std::to_string(domain));
+    const LaunchRun r = launch(s, dir, domain++, "lockstep");
+    ASSERT_TRUE(r.status.ok()) << s << ": " << r.status.describe() << "\n" << r.out << r.err;
+    const std::string summary = slurp(dir + "/out/summary.json");
+    EXPECT_TRUE(objects(summary, "detections").empty()) << s << "\n" << summary;
+    EXPECT_TRUE(objects(summary, "faults").empty()) << s;
+    for (const auto& corner : objects(summary, "corners")) {
+      EXPECT_EQ(num(corner, "samples_rejected_by_guard"), 0.0) << s << " " << corner.at("corner");
+      EXPECT_LT(num(corner, "ccu_lost_detected_s"), 0.0) << s << " " << corner.at("corner");
+    }
+    fs::remove_all(dir);
+  }
+}
+
+// Domain 186: in real time, a silenced corner (FR) and a killed corner (RR) are detected within
+// 50 ms (DDS deadline 15 ms on the measurements); the dead process is named once its
+// participant's discovery lease (2 s) has run out.
+TEST(SystemFaultsRealtime, KilledAndSilencedCornersDetectedWithin50ms) {
+  const std::string dir = scratch("realtime");
+  const LaunchRun r = launch("tests/system/data/rt_kill_silence.yaml", dir, 186, "realtime");
+  ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
+  const std::string summary = slurp(dir + "/out/summary.json");
+  const auto faults = objects(summary, "faults");
+  ASSERT_EQ(faults.size(), 2u) << summary;
+  for (const auto& f : faults) {
+    EXPECT_EQ(f.at("detected"), "true") << f.at("corner");
+    EXPECT_GT(num(f, "latency_ms"), 0.0) << f.at("corner");
+    EXPECT_LT(num(f, "latency_ms"), 50.0) << f.at("corner") << " " << f.at("type");
+    EXPECT_EQ(f.at("correct"), "true") << f.at("corner") << ": " << f.at("diagnosis");
+  }
+  EXPECT_EQ(faults[0].at("diagnosis"), "link_lost");
+  EXPECT_EQ(faults[1].at("diagnosis"), "process_lost");
+  fs::remove_all(dir);
+}
+
+}  // namespace
