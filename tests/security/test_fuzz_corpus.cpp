@@ -10,10 +10,16 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <ostream>
 #include <string>
 #include <vector>
 
 #include "entry_points.hpp"
+
+namespace bbw::fuzz {
+// Test names and failure messages show the target's name.
+inline void PrintTo(const Target& t, std::ostream* os) { *os << t.name; }
+}  // namespace bbw::fuzz
 
 namespace {
 
