@@ -74,6 +74,8 @@ int main(int argc, char** argv) {
         return max_blocks >= 0 && echoed >= max_blocks;
       });
     }
+    // Deliver the last replies before the writer goes away (otherwise the peer may miss them).
+    commands.get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2, 0));
     std::cout << "bbw_dds_echo: echoed " << echoed << " blocks" << std::endl;
     return 0;
   } catch (const std::exception& e) {

@@ -168,7 +168,12 @@ int main(int argc, char** argv) {
                                   "--mode", mode, "--stats", corner_stats_file(c, incarnation),
                                   "--periods-log", out_dir + "/corner_" + c + "_periods.csv",
                                   "--discovery-timeout", disc};
-    if (process_faults) argv.push_back("--process-faults");
+    if (process_faults) {
+      argv.push_back("--process-faults");
+      // In lockstep the CCU may hold the clock for a restarted corner for up to the discovery
+      // timeout: the other corners must wait for their next command at least that long.
+      argv.insert(argv.end(), {"--peer-timeout", std::to_string(discovery_s + 10.0)});
+    }
     if (incarnation > 0) {
       argv.insert(argv.end(), {"--incarnation", std::to_string(incarnation), "--resume-at", std::to_string(resume_at_s)});
     }
