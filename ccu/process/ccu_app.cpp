@@ -10,6 +10,7 @@
 #include "bbw/dds/topics.hpp"
 #include "bbw/faults/link_faults.hpp"
 #include "bbw/launch/stats_file.hpp"
+#include "bbw/security/dds_security.hpp"
 
 namespace bbw::ccu {
 
@@ -76,12 +77,16 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
       periods_(static_cast<std::uint64_t>(std::ceil(scenario.duration_s / scenario.ccu_period_s - 1e-9))),
       channels_(make_channels(scenario)),
       participant_(named(options.participant)),
-      blocks_(participant_, dds::kMeasurementTopic,
-              dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_reader, events),
-      health_(participant_, dds::kHealthTopic, "state_reader", events),
       commands_(participant_, dds::kCommandTopic,
                 dds::profiles_for(options.mode == ClockMode::Lockstep).command_writer, events),
       calibration_(participant_, dds::kCalibrationTopic, "state_writer", events) {
+  for (const auto& ch : channels_) {
+    const dds::Partition partition{security::corner_partition(static_cast<int>(ch.slot))};
+    blocks_.push_back(std::make_unique<BlockReader>(
+        participant_, dds::kMeasurementTopic,
+        dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_reader, events, partition));
+    health_.push_back(std::make_unique<HealthReader>(participant_, dds::kHealthTopic, "state_reader", events, partition));
+  }
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
   detections_.reserve(256);
   if (options.process_faults) {
@@ -108,6 +113,9 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
 }
 
 CcuApp::~CcuApp() {
+  // The readers go before the participant (members are destroyed after this body).
+  blocks_.clear();
+  health_.clear();
   for (auto& ch : channels_) {
     if (ch.csv != nullptr) std::fclose(ch.csv);
   }
@@ -125,11 +133,16 @@ double CcuApp::realtime_now_s() const { return std::chrono::duration<double>(Clo
 
 void CcuApp::drain_health() {
   msg::CornerHealth h;
-  while (health_.take(h)) {
-    if (CornerChannel* ch = channel(h.corner_id())) {
-      if (h.incarnation() < ch->health_incarnation) continue;  // an older process's last word
-      ch->health_incarnation = h.incarnation();
-      ch->health = h.status();
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    CornerChannel& ch = channels_[i];
+    while (health_[i]->take(h)) {
+      if (h.corner_id() != ch.slot) {
+        ++ch.foreign_health;  // another corner id in this corner's partition
+        continue;
+      }
+      if (h.incarnation() < ch.health_incarnation) continue;  // an older process's last word
+      ch.health_incarnation = h.incarnation();
+      ch.health = h.status();
     }
   }
 }
@@ -138,18 +151,20 @@ bool CcuApp::wait_for_corners(std::string& error) {
   const int n = static_cast<int>(channels_.size());
   const bool ok = events_.wait_for(options_.discovery_timeout, [&] {
     drain_health();
-    bool all = blocks_.matched() >= n && commands_.matched() >= n && calibration_.matched() >= n;
-    for (const auto& ch : channels_) all = all && ch.health >= 0;
+    bool all = commands_.matched() >= n && calibration_.matched() >= n;
+    for (std::size_t i = 0; i < channels_.size(); ++i) all = all && channels_[i].health >= 0 && blocks_[i]->matched() >= 1;
     return all;
   });
   if (!ok && !events_.interrupted()) {
+    int matched_blocks = 0;
+    for (const auto& r : blocks_) matched_blocks += r->matched() >= 1 ? 1 : 0;
     std::string missing;
     for (const auto& ch : channels_) {
       if (ch.health < 0) missing += (missing.empty() ? "" : ", ") + std::string(dds::corner_name(ch.corner));
     }
     error = "corners not discovered within " + std::to_string(options_.discovery_timeout.count()) +
             " ms: " + (missing.empty() ? std::string("(endpoints incomplete)") : missing) +
-            " (measurement writers matched " + std::to_string(blocks_.matched()) + " of " + std::to_string(n) + ")";
+            " (measurement writers matched " + std::to_string(matched_blocks) + " of " + std::to_string(n) + ")";
   }
   return ok;
 }
@@ -211,13 +226,16 @@ void CcuApp::publish_calibration(CornerChannel& ch, double time_s) {
   calibration_.write(state);
 }
 
-void CcuApp::process_block(const msg::MeasurementBlock& b, const eprosima::fastdds::dds::SampleInfo& info,
-                           double arrival_s) {
-  CornerChannel* ch = channel(b.corner_id());
-  if (ch == nullptr) {
-    ++unknown_corner_blocks_;  // a corner id that does not exist in this scenario
+void CcuApp::process_block(CornerChannel& channel_of_partition, const msg::MeasurementBlock& b,
+                           const eprosima::fastdds::dds::SampleInfo& info, double arrival_s) {
+  if (b.corner_id() != channel_of_partition.slot) {
+    // Another corner id in this corner's partition: a corner posing as another (or as one
+    // that does not exist). Dropped and counted before anything reads it.
+    ++channel_of_partition.foreign_blocks;
+    if (channel(b.corner_id()) == nullptr) ++unknown_corner_blocks_;
     return;
   }
+  CornerChannel* ch = &channel_of_partition;
   ch->instance = info.instance_handle;
   if (!ch->have_handles || ch->writer != info.publication_handle) {
     ch->writer = info.publication_handle;
@@ -285,7 +303,11 @@ void CcuApp::process_block(const msg::MeasurementBlock& b, const eprosima::fastd
 void CcuApp::drain_blocks(double arrival_s) {
   eprosima::fastdds::dds::SampleInfo info;
   const bool realtime = options_.mode == ClockMode::Realtime;
-  while (blocks_.take(block_, info)) process_block(block_, info, realtime ? realtime_now_s() : arrival_s);
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    while (blocks_[i]->take(block_, info)) {
+      process_block(channels_[i], block_, info, realtime ? realtime_now_s() : arrival_s);
+    }
+  }
 }
 
 // QoS events into link events. Realtime: at the time they happened. Lockstep: deadlines are
@@ -294,8 +316,9 @@ void CcuApp::drain_blocks(double arrival_s) {
 // cannot change the result.
 void CcuApp::drain_qos_events(double now_s, bool lockstep) {
   dds::QosEvent e;
-  while (blocks_.take_event(e)) {
-    for (auto& ch : channels_) {
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    CornerChannel& ch = channels_[i];
+    while (blocks_[i]->take_event(e)) {
       if (!ch.have_handles) continue;
       const double t = lockstep ? now_s : std::chrono::duration<double>(e.at - t0_).count();
       if (e.kind == dds::QosEvent::Kind::DeadlineMissed && e.handle == ch.instance) {
@@ -481,10 +504,19 @@ void CcuApp::write_stats(const std::string& file) const {
   w.set("sim_s", sim_s_);
   w.set("wall_s", wall_s_);
   w.set("killed_at_s", kill_at_s_ ? sim_s_ : -1.0);
-  w.set("measurement_deadlines_missed", static_cast<unsigned long long>(blocks_.deadlines_missed()));
-  w.set("measurement_liveliness_lost", static_cast<unsigned long long>(blocks_.liveliness_lost()));
-  w.set("measurement_samples_lost", static_cast<unsigned long long>(blocks_.samples_lost()));
-  w.set("qos_events_dropped", static_cast<unsigned long long>(blocks_.events_dropped()));
+  std::uint64_t deadlines = 0, liveliness = 0, lost = 0, dropped = 0, foreign = 0;
+  for (const auto& r : blocks_) {
+    deadlines += r->deadlines_missed();
+    liveliness += r->liveliness_lost();
+    lost += r->samples_lost();
+    dropped += r->events_dropped();
+  }
+  for (const auto& ch : channels_) foreign += ch.foreign_blocks + ch.foreign_health;
+  w.set("measurement_deadlines_missed", static_cast<unsigned long long>(deadlines));
+  w.set("measurement_liveliness_lost", static_cast<unsigned long long>(liveliness));
+  w.set("measurement_samples_lost", static_cast<unsigned long long>(lost));
+  w.set("qos_events_dropped", static_cast<unsigned long long>(dropped));
+  w.set("foreign_corner_samples", static_cast<unsigned long long>(foreign));
   w.set("unknown_corner_blocks", static_cast<unsigned long long>(unknown_corner_blocks_));
   w.set("command_write_failures", static_cast<unsigned long long>(commands_.write_failures()));
   std::string corners;
@@ -497,6 +529,8 @@ void CcuApp::write_stats(const std::string& file) const {
     w.set(p + "blocks_received", static_cast<unsigned long long>(ch.blocks_received));
     w.set(p + "samples_received", static_cast<unsigned long long>(ch.samples_received));
     w.set(p + "samples_invalid", static_cast<unsigned long long>(ch.samples_invalid));
+    w.set(p + "foreign_blocks", static_cast<unsigned long long>(ch.foreign_blocks));
+    w.set(p + "foreign_health", static_cast<unsigned long long>(ch.foreign_health));
     w.set(p + "block_gaps", static_cast<unsigned long long>(ch.block_gaps));
     w.set(p + "sample_gaps", static_cast<unsigned long long>(ch.sample_gaps));
     w.set(p + "rejoins", static_cast<unsigned long long>(ch.rejoins));

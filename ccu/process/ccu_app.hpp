@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -67,6 +68,10 @@ struct CornerChannel {
   std::uint64_t blocks_received = 0;
   std::uint64_t samples_received = 0;
   std::uint64_t samples_invalid = 0;   // rejected by the sample guard
+  // Received in this corner's partition with another corner id (a corner posing as another,
+  // or a corner id that does not exist): dropped before anything reads them.
+  std::uint64_t foreign_blocks = 0;
+  std::uint64_t foreign_health = 0;
   std::uint64_t block_gaps = 0;        // blocks missing or out of order (within an incarnation)
   std::uint64_t sample_gaps = 0;       // samples missing between consecutive blocks (within one)
   std::uint64_t rejoins = 0;           // new incarnations seen
@@ -101,8 +106,8 @@ class CcuApp {
  private:
   bool wait_for_corners(std::string& error);
   void send_commands(std::uint64_t step, bool stop, bool log = true);
-  void process_block(const msg::MeasurementBlock& b, const eprosima::fastdds::dds::SampleInfo& info,
-                     double arrival_s);
+  void process_block(CornerChannel& ch, const msg::MeasurementBlock& b,
+                     const eprosima::fastdds::dds::SampleInfo& info, double arrival_s);
   void drain_blocks(double arrival_s);
   void drain_qos_events(double now_s, bool lockstep);
   void drain_health();
@@ -122,8 +127,12 @@ class CcuApp {
   std::vector<CornerChannel> channels_;
 
   dds::Participant participant_;
-  dds::Reader<msg::MeasurementBlockPubSubType> blocks_;
-  dds::Reader<msg::CornerHealthPubSubType> health_;
+  // One measurement and one health reader per corner (same index as channels_), each in that
+  // corner's partition (corner_FL, ...): DDS Security lets a corner write only there.
+  using BlockReader = dds::Reader<msg::MeasurementBlockPubSubType>;
+  using HealthReader = dds::Reader<msg::CornerHealthPubSubType>;
+  std::vector<std::unique_ptr<BlockReader>> blocks_;
+  std::vector<std::unique_ptr<HealthReader>> health_;
   dds::Writer<msg::ClampCommandPubSubType> commands_;
   dds::Writer<msg::CalibrationStatePubSubType> calibration_;
 

@@ -5,6 +5,10 @@
 //           [--calibrator FILE.yaml] [--fusion-weight W] [--friction-feedback on|off]
 //           [--discovery-timeout S] [--peer-timeout S]
 //           [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--process-faults]
+//           [--secure KEYS_DIR]
+//
+// --secure: DDS Security with the CCU's identity from KEYS_DIR (`./bbw keys KEYS_DIR`,
+// docs/security.md); a missing key file is a configuration error (exit 2).
 //
 // The scenario may carry a fault schedule (docs/faults.md). --process-faults (given by
 // bbw_launch, which carries process faults out) makes the CCU freeze at its scheduled kill for
@@ -24,6 +28,7 @@
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/launch/signals.hpp"
 #include "bbw/scenario/load.hpp"
+#include "bbw/security/dds_security.hpp"
 #include "ccu_app.hpp"
 
 namespace {
@@ -32,7 +37,8 @@ const char* kUsage =
     "usage: bbw_ccu --scenario FILE [--domain N] [--mode lockstep|realtime] [--out DIR]\n"
     "               [--calibrator FILE.yaml] [--fusion-weight W] [--friction-feedback on|off]\n"
     "               [--discovery-timeout S] [--peer-timeout S]\n"
-    "               [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--process-faults]\n";
+    "               [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--process-faults]\n"
+    "               [--secure KEYS_DIR]\n";
 
 std::chrono::milliseconds seconds_arg(const std::string& key, const std::string& v) {
   char* end = nullptr;
@@ -51,7 +57,7 @@ int main(int argc, char** argv) {
   bbw::launch::SignalWatcher signals([&](int) { events.interrupt(); });
 
   CcuOptions opt;
-  std::string scenario_file, mode = "lockstep", calibrator_file = BBW_DEFAULT_CALIBRATOR_CONFIG;
+  std::string scenario_file, mode = "lockstep", calibrator_file = BBW_DEFAULT_CALIBRATOR_CONFIG, secure_dir;
   std::optional<std::string> domain_arg;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -82,6 +88,7 @@ int main(int argc, char** argv) {
       else if (k == "--dds-profiles") opt.participant.profiles_file = next();
       else if (k == "--dds-participant-profile") opt.participant.profile = next();
       else if (k == "--process-faults") opt.process_faults = true;
+      else if (k == "--secure") secure_dir = next();
       else if (k == "-h" || k == "--help") { std::cout << kUsage; return 0; }
       else throw std::invalid_argument("unknown argument '" + k + "'");
     }
@@ -99,6 +106,10 @@ int main(int argc, char** argv) {
   std::optional<bbw::scenario::Scenario> scenario;
   std::optional<bbw::calibration::CalibratorConfig> calibrator;
   try {
+    if (!secure_dir.empty()) {
+      opt.participant.properties = bbw::security::participant_properties(
+          bbw::security::files_for(secure_dir, bbw::security::kCcuIdentity));
+    }
     auto fs = bbw::faults::load_fault_scenario(scenario_file);
     scenario = std::move(fs.scenario);
     opt.schedule = std::move(fs.faults);

@@ -1,5 +1,7 @@
 #include "corner_app.hpp"
 
+#include "bbw/security/dds_security.hpp"
+
 #include <signal.h>
 #include <unistd.h>
 
@@ -57,9 +59,13 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       steps_per_period_(steps_per_period(scenario)),
       periods_(static_cast<std::uint64_t>(std::ceil(scenario.duration_s / scenario.ccu_period_s - 1e-9))),
       participant_(named(options.participant, options.corner)),
+      // Measurements and health in the corner's own partition (corner_FL, ...), secure or not:
+      // the permissions grant a corner only that one (docs/security.md).
       blocks_(participant_, dds::kMeasurementTopic,
-              dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_writer, events),
-      health_(participant_, dds::kHealthTopic, "state_writer", events),
+              dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_writer, events,
+              dds::Partition{security::corner_partition(static_cast<int>(dds::corner_index(options.corner)))}),
+      health_(participant_, dds::kHealthTopic, "state_writer", events,
+              dds::Partition{security::corner_partition(static_cast<int>(dds::corner_index(options.corner)))}),
       // No DDS content filter on these topics: Fast DDS 2.9 evaluates DDS-SQL filters on the
       // writer by deserialising into DynamicData, which throws and catches internally on every
       // sample and made the CCU's command writes its largest cost. Corners drop the other

@@ -4,6 +4,10 @@
 //              [--stats FILE] [--discovery-timeout S] [--peer-timeout S]
 //              [--dds-profiles FILE.xml] [--dds-participant-profile NAME]
 //              [--periods-log FILE] [--process-faults] [--incarnation N --resume-at S]
+//              [--secure KEYS_DIR]
+//
+// --secure: DDS Security with this corner's identity from KEYS_DIR (`./bbw keys KEYS_DIR`,
+// docs/security.md); a missing key file is a configuration error (exit 2).
 //
 // The scenario may carry a fault schedule (docs/faults.md): this corner's sensor, actuator and
 // network faults are injected here. --process-faults (given by bbw_launch) makes the corner
@@ -25,6 +29,7 @@
 #include "bbw/launch/signals.hpp"
 #include "bbw/launch/stats_file.hpp"
 #include "bbw/scenario/load.hpp"
+#include "bbw/security/dds_security.hpp"
 #include "corner_app.hpp"
 
 namespace {
@@ -33,7 +38,8 @@ const char* kUsage =
     "usage: bbw_corner --corner FL|FR|RL|RR --scenario FILE [--domain N] [--mode lockstep|realtime]\n"
     "                  [--stats FILE] [--discovery-timeout S] [--peer-timeout S]\n"
     "                  [--dds-profiles FILE.xml] [--dds-participant-profile NAME]\n"
-    "                  [--periods-log FILE] [--process-faults] [--incarnation N --resume-at S]\n";
+    "                  [--periods-log FILE] [--process-faults] [--incarnation N --resume-at S]\n"
+    "                  [--secure KEYS_DIR]\n";
 
 std::chrono::milliseconds seconds_arg(const std::string& key, const std::string& v) {
   char* end = nullptr;
@@ -52,7 +58,7 @@ int main(int argc, char** argv) {
   bbw::launch::SignalWatcher signals([&](int) { events.interrupt(); });
 
   CornerOptions opt;
-  std::string corner_arg, scenario_file, mode = "lockstep";
+  std::string corner_arg, scenario_file, mode = "lockstep", secure_dir;
   std::optional<std::string> domain_arg;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -71,6 +77,7 @@ int main(int argc, char** argv) {
       else if (k == "--dds-profiles") opt.participant.profiles_file = next();
       else if (k == "--dds-participant-profile") opt.participant.profile = next();
       else if (k == "--periods-log") opt.periods_log = next();
+      else if (k == "--secure") secure_dir = next();
       else if (k == "--process-faults") opt.process_faults = true;
       else if (k == "--incarnation") {
         const std::string v = next();
@@ -104,6 +111,10 @@ int main(int argc, char** argv) {
   // Config is loaded and validated before any DDS entity exists.
   std::optional<bbw::scenario::Scenario> scenario;
   try {
+    if (!secure_dir.empty()) {
+      opt.participant.properties = bbw::security::participant_properties(
+          bbw::security::files_for(secure_dir, bbw::security::corner_identity(corner_arg)));
+    }
     auto fs = bbw::faults::load_fault_scenario(scenario_file);
     scenario = std::move(fs.scenario);
     opt.schedule = std::move(fs.faults);

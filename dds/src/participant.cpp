@@ -4,6 +4,8 @@
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/dds/publisher/qos/PublisherQos.hpp>
+#include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
 
 #include <cstdlib>
 #include <filesystem>
@@ -76,6 +78,28 @@ Participant::~Participant() {
   // this object; delete_contained_entities() releases whatever remains.
   participant_->delete_contained_entities();
   fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+fdds::Publisher& Participant::publisher(const std::string& partition) {
+  if (partition.empty()) return *publisher_;
+  if (auto it = partition_publishers_.find(partition); it != partition_publishers_.end()) return *it->second;
+  fdds::PublisherQos qos = fdds::PUBLISHER_QOS_DEFAULT;
+  qos.partition().push_back(partition.c_str());
+  fdds::Publisher* pub = participant_->create_publisher(qos);
+  if (pub == nullptr) throw DdsError("cannot create publisher in partition '" + partition + "'");
+  partition_publishers_.emplace(partition, pub);
+  return *pub;
+}
+
+fdds::Subscriber& Participant::subscriber(const std::string& partition) {
+  if (partition.empty()) return *subscriber_;
+  if (auto it = partition_subscribers_.find(partition); it != partition_subscribers_.end()) return *it->second;
+  fdds::SubscriberQos qos = fdds::SUBSCRIBER_QOS_DEFAULT;
+  qos.partition().push_back(partition.c_str());
+  fdds::Subscriber* sub = participant_->create_subscriber(qos);
+  if (sub == nullptr) throw DdsError("cannot create subscriber in partition '" + partition + "'");
+  partition_subscribers_.emplace(partition, sub);
+  return *sub;
 }
 
 fdds::Topic& Participant::topic_impl(const std::string& name, fdds::TypeSupport type) {

@@ -9,12 +9,25 @@
 //   {"as":"rogue","participant":true,"writer":true,"max_matched":0,"written":600}
 // Exit 0 when the attempt ran (refusals are results, not errors), 2 on bad usage, 1 otherwise.
 //
+// --measurements flood|hostile writes measurement blocks instead of commands, as corner
+// --corner (its id, in its partition corner_<C>), with the realtime measurement QoS:
+//   flood    --rate-x N blocks (5 plausible samples each, continuing seq and time) every 5 ms:
+//            N times a corner's rate (docs/security.md, "Flooding")
+//   hostile  one malformed block every 5 ms, cycling through: NaN position, infinite load cell,
+//            position out of range, load cell out of range, sequence backwards (seq 1),
+//            another corner's id, a corner id that does not exist (7)
+// The JSON line then also gives "blocks" (written) and, for hostile, "foreign" (blocks with
+// another corner's id), "unknown" (id 7) and "bad_samples" (NaN/inf/out of range/backwards).
+//
 //   bbw_intruder --as none|rogue|corner [--keys DIR] [--corner FL] [--domain N]
 //                [--duration-s S] [--force-kN F] [--dds-profiles FILE.xml]
+//                [--measurements flood|hostile [--rate-x N]]
 #include <bbw/idl/bbw_msgsPubSubTypes.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -32,10 +45,12 @@
 namespace {
 
 using CommandT = bbw::msg::ClampCommandPubSubType;
+using BlockT = bbw::msg::MeasurementBlockPubSubType;
 
 constexpr const char* kUsage =
     "usage: bbw_intruder --as none|rogue|corner [--keys DIR] [--corner FL|FR|RL|RR] [--domain N]\n"
-    "                    [--duration-s S] [--force-kN F] [--dds-profiles FILE.xml]\n";
+    "                    [--duration-s S] [--force-kN F] [--dds-profiles FILE.xml]\n"
+    "                    [--measurements flood|hostile [--rate-x N]]\n";
 
 struct Options {
   std::string as;
@@ -45,7 +60,76 @@ struct Options {
   double duration_s = 3.0;
   double force_kN = 99.0;
   std::string profiles_file;
+  std::string measurements;  // "", flood, hostile
+  int rate_x = 20;
 };
+
+// What the measurement modes wrote.
+struct BlockCounts {
+  std::uint64_t blocks = 0, foreign = 0, unknown = 0, bad_samples = 0;
+};
+
+// One plausible rig sample (passes the CCU's sample guard).
+bbw::msg::MeasurementSample plausible(std::uint64_t seq) {
+  bbw::msg::MeasurementSample m;
+  m.seq(seq);
+  m.time_s(static_cast<double>(seq) * 0.001);
+  m.position_rev(2.0 + std::sin(static_cast<double>(seq) * 0.01));
+  m.speed_rev_s(0.5);
+  m.force_internal_kN(10.0);
+  m.force_external_kN(10.0);
+  m.force_true_kN(10.0);
+  m.temperature_C(40.0);
+  m.motor_current_A(2.0);
+  m.command(2.0);
+  m.status(0);
+  return m;
+}
+
+// Writes blocks as corner `corner_id` until `end`: flood (rate_x plausible blocks per 5 ms) or
+// hostile (one malformed block per 5 ms, kinds in turn).
+BlockCounts write_blocks(bbw::dds::Writer<BlockT>& w, bbw::dds::Events& events, const Options& o,
+                         std::uint8_t corner_id, std::chrono::steady_clock::time_point end) {
+  BlockCounts n;
+  std::uint64_t seq = 0, block = 0, tick_n = 0;
+  bbw::msg::MeasurementBlock b;
+  auto tick = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() < end) {
+    const int count = o.measurements == "flood" ? o.rate_x : 1;
+    for (int i = 0; i < count; ++i) {
+      b.corner_id(corner_id);
+      b.block_seq(block++);
+      b.incarnation(0);
+      b.samples().clear();
+      for (int k = 0; k < 5; ++k) b.samples().push_back(plausible(++seq));
+      bool foreign = false, unknown = false;
+      if (o.measurements == "hostile") {
+        auto& s0 = b.samples()[0];
+        switch (tick_n % 7) {
+          case 0: s0.position_rev(std::nan("")); break;
+          case 1: s0.force_internal_kN(std::numeric_limits<double>::infinity()); break;
+          case 2: s0.position_rev(50.0); break;
+          case 3: s0.force_internal_kN(1e6); break;
+          case 4: s0.seq(1); s0.time_s(0.001); break;
+          case 5: b.corner_id(static_cast<std::uint8_t>((corner_id + 1) % 4)); foreign = true; break;
+          default: b.corner_id(7); unknown = true; break;
+        }
+      }
+      b.first_sample_seq(b.samples().front().seq());
+      b.period_start_s(b.samples().front().time_s() - 0.001);
+      if (w.write(b)) {
+        ++n.blocks;
+        if (foreign) ++n.foreign;
+        else if (unknown) ++n.unknown;
+        else if (o.measurements == "hostile") ++n.bad_samples;
+      }
+    }
+    ++tick_n;
+    tick += std::chrono::milliseconds(5);
+    events.wait_until(std::min(tick, end), [] { return false; });
+  }
+  return n;
+}
 
 double parse_positive(const std::string& text, const std::string& what) {
   std::size_t used = 0;
@@ -71,10 +155,19 @@ Options parse(int argc, char** argv) {
     else if (k == "--duration-s") o.duration_s = parse_positive(next(), "--duration-s");
     else if (k == "--force-kN") o.force_kN = parse_positive(next(), "--force-kN");
     else if (k == "--dds-profiles") o.profiles_file = next();
+    else if (k == "--measurements") o.measurements = next();
+    else if (k == "--rate-x") {
+      const double r = parse_positive(next(), "--rate-x");
+      if (r != std::floor(r) || r > 1000) throw std::invalid_argument("--rate-x must be an integer in 1..1000");
+      o.rate_x = static_cast<int>(r);
+    }
     else throw std::invalid_argument("unknown argument '" + k + "'");
   }
   if (o.as != "none" && o.as != "rogue" && o.as != "corner") {
     throw std::invalid_argument("--as must be none, rogue or corner, got '" + o.as + "'");
+  }
+  if (!o.measurements.empty() && o.measurements != "flood" && o.measurements != "hostile") {
+    throw std::invalid_argument("--measurements must be flood or hostile, got '" + o.measurements + "'");
   }
   return o;
 }
@@ -115,13 +208,37 @@ int main(int argc, char** argv) {
   bool writer_ok = false;
   int max_matched = 0;
   std::uint64_t written = 0;
+  BlockCounts blocks;
   std::string refused;
   try {
     bbw::dds::Events events;
     bbw::dds::Participant participant(participant_options(o));
     participant_ok = true;
     std::unique_ptr<bbw::dds::Writer<CommandT>> writer;
-    try {
+    if (!o.measurements.empty()) {
+      const std::string id = bbw::security::corner_identity(o.corner);  // validates the corner
+      const int corner_id = id == "fl" ? 0 : id == "fr" ? 1 : id == "rl" ? 2 : 3;
+      std::unique_ptr<bbw::dds::Writer<BlockT>> bw;
+      try {
+        bw = std::make_unique<bbw::dds::Writer<BlockT>>(
+            participant, bbw::dds::kMeasurementTopic, "measurement_writer_realtime", events,
+            bbw::dds::Partition{bbw::security::corner_partition(corner_id)});
+        writer_ok = true;
+      } catch (const bbw::dds::DdsError& e) {
+        refused = e.what();
+      }
+      if (bw) {
+        const auto end = std::chrono::steady_clock::now() +
+                         std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                             std::chrono::duration<double>(o.duration_s));
+        // Write only once a reader listens (the CCU), within the duration.
+        bw->wait_for_matched(1, end - std::chrono::steady_clock::now());
+        blocks = write_blocks(*bw, events, o, static_cast<std::uint8_t>(corner_id), end);
+        max_matched = bw->matched();
+        written = blocks.blocks;
+        bw->get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
+      }
+    } else try {
       writer = std::make_unique<bbw::dds::Writer<CommandT>>(participant, bbw::dds::kCommandTopic,
                                                             "command_writer_realtime", events);
       writer_ok = true;
@@ -159,9 +276,15 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  std::printf("{\"as\":\"%s\",\"participant\":%s,\"writer\":%s,\"max_matched\":%d,\"written\":%llu}\n",
+  std::printf("{\"as\":\"%s\",\"participant\":%s,\"writer\":%s,\"max_matched\":%d,\"written\":%llu",
               o.as.c_str(), participant_ok ? "true" : "false", writer_ok ? "true" : "false", max_matched,
               static_cast<unsigned long long>(written));
+  if (!o.measurements.empty()) {
+    std::printf(",\"blocks\":%llu,\"foreign\":%llu,\"unknown\":%llu,\"bad_samples\":%llu",
+                static_cast<unsigned long long>(blocks.blocks), static_cast<unsigned long long>(blocks.foreign),
+                static_cast<unsigned long long>(blocks.unknown), static_cast<unsigned long long>(blocks.bad_samples));
+  }
+  std::printf("}\n");
   if (!refused.empty()) std::fprintf(stderr, "bbw_intruder: refused: %s\n", refused.c_str());
   return 0;
 }

@@ -2,6 +2,11 @@
 //
 //   bbw_launch SCENARIO.yaml --out DIR [--mode lockstep|realtime] [--domain N]
 //              [--discovery-timeout S] [--friction-feedback on|off] [--no-report]
+//              [--secure [--keys DIR]]
+//
+// --secure: DDS Security (docs/security.md) with the keys in DIR (default keys/ in the
+// repository, gitignored); when a file is missing scripts/bbw-keys.sh DIR creates it (output in
+// OUT/keys.out/.err), then every child gets --secure DIR.
 //
 // Starts bbw_ccu and bbw_corner (one per scenario corner) as separate processes with their
 // output in DIR/<name>.out/.err, waits for them to finish within a bounded wall time, and
@@ -21,6 +26,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -40,6 +46,7 @@
 #include "bbw/launch/signals.hpp"
 #include "bbw/launch/stats_file.hpp"
 #include "bbw/scenario/load.hpp"
+#include "bbw/security/dds_security.hpp"
 #include "fault_report.hpp"
 #include "report.hpp"
 #include "summary.hpp"
@@ -52,7 +59,8 @@ using bbw::launch::Clock;
 
 const char* kUsage =
     "usage: bbw_launch SCENARIO.yaml --out DIR [--mode lockstep|realtime] [--domain N]\n"
-    "                  [--discovery-timeout S] [--friction-feedback on|off] [--no-report]\n";
+    "                  [--discovery-timeout S] [--friction-feedback on|off] [--no-report]\n"
+    "                  [--secure [--keys DIR]]\n";
 
 std::string last_line(const std::string& file) {
   std::ifstream f(file);
@@ -86,6 +94,8 @@ int main(int argc, char** argv) {
   std::optional<std::string> domain_arg;
   double discovery_s = 20.0;
   bool report = true;
+  bool secure = false;
+  std::string keys_dir = std::string(BBW_REPO_DIR) + "/keys";
   int domain = 0;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -106,6 +116,8 @@ int main(int argc, char** argv) {
         }
       } else if (k == "--friction-feedback") feedback = next();
       else if (k == "--no-report") report = false;
+      else if (k == "--secure") secure = true;
+      else if (k == "--keys") keys_dir = next();
       else if (k == "-h" || k == "--help") { std::cout << kUsage; return 0; }
       else if (!k.empty() && k[0] == '-') throw std::invalid_argument("unknown argument '" + k + "'");
       else if (scenario_file.empty()) scenario_file = k;
@@ -143,6 +155,36 @@ int main(int argc, char** argv) {
     std::cerr << "bbw_launch: cannot create output directory " << out_dir << "\n";
     return 2;
   }
+  if (secure) {
+    // Keys: created by scripts/bbw-keys.sh when any file is missing (idempotent), then checked.
+    std::error_code ec;
+    keys_dir = std::filesystem::absolute(keys_dir, ec).lexically_normal().string();
+    auto check_keys = [&]() -> std::string {
+      try {
+        for (const auto& id : bbw::security::identities()) bbw::security::files_for(keys_dir, id);
+      } catch (const std::exception& e) {
+        return e.what();
+      }
+      return "";
+    };
+    if (!check_keys().empty()) {
+      std::cout << "bbw_launch: creating DDS Security keys in " << keys_dir << std::endl;
+      Child keys("bbw-keys.sh", {std::string(BBW_REPO_DIR) + "/scripts/bbw-keys.sh", keys_dir},
+                 out_dir + "/keys.out", out_dir + "/keys.err");
+      const auto st = keys.wait_until(Clock::now() + 120s);
+      if (!st || !st->ok()) {
+        if (!st) keys.stop(1000ms);
+        std::cerr << "bbw_launch: scripts/bbw-keys.sh " << keys_dir << " failed ("
+                  << (st ? st->describe() : std::string("no exit within 120 s")) << "): "
+                  << last_line(out_dir + "/keys.err") << "\n";
+        return 1;
+      }
+    }
+    if (const std::string missing = check_keys(); !missing.empty()) {
+      std::cerr << "bbw_launch: " << missing << "\n";
+      return 2;
+    }
+  }
   const auto shm = bbw::dds::cleanup_stale_shm();
   if (!shm.removed.empty()) {
     std::cout << "bbw_launch: removed " << shm.removed.size() << " stale Fast DDS shared-memory files" << std::endl;
@@ -174,6 +216,7 @@ int main(int argc, char** argv) {
       // timeout: the other corners must wait for their next command at least that long.
       argv.insert(argv.end(), {"--peer-timeout", std::to_string(discovery_s + 10.0)});
     }
+    if (secure) argv.insert(argv.end(), {"--secure", keys_dir});
     if (incarnation > 0) {
       argv.insert(argv.end(), {"--incarnation", std::to_string(incarnation), "--resume-at", std::to_string(resume_at_s)});
     }
@@ -187,6 +230,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> ccu_argv{bin + "/bbw_ccu", "--scenario", scenario_file, "--domain", dom, "--mode", mode,
                                       "--out", out_dir, "--discovery-timeout", disc, "--friction-feedback", feedback};
     if (process_faults) ccu_argv.push_back("--process-faults");
+    if (secure) ccu_argv.insert(ccu_argv.end(), {"--secure", keys_dir});
     children.push_back(std::make_unique<Child>("bbw_ccu", ccu_argv, out_dir + "/ccu.out", out_dir + "/ccu.err"));
     for (const auto& c : scenario->corners) spawn_corner(c.name, 0, 0.0);
   } catch (const std::exception& e) {
@@ -335,7 +379,7 @@ int main(int argc, char** argv) {
     std::vector<std::vector<std::pair<double, double>>> period_logs;
     double max_jitter = 0.0;
     j.begin_object().value("scenario", scenario->name).value("scenario_file", scenario_file).value("mode", mode);
-    j.value("domain", domain).value("friction_feedback", feedback);
+    j.value("domain", domain).value("friction_feedback", feedback).value("secure", secure);
     j.begin_array("corners");
     for (const auto& c : scenario->corners) {
       // Counters summed over the corner's incarnations (a restarted process has its own file).

@@ -29,6 +29,12 @@ class DdsError : public std::runtime_error {
 inline constexpr const char* kLocalhostProfile = "bbw_localhost";  // SHM + UDPv4 on 127.0.0.1
 inline constexpr const char* kNetworkProfile = "bbw_network";      // explicit multi-host config
 
+// The partition of a Writer / Reader (a named type so it cannot be confused with other
+// arguments); empty: the participant's partition-less publisher / subscriber.
+struct Partition {
+  std::string name;
+};
+
 struct ParticipantOptions {
   int domain_id = 0;
   std::string profiles_file;            // empty: default_profiles_file()
@@ -55,6 +61,11 @@ class Participant {
   eprosima::fastdds::dds::DomainParticipant& get() { return *participant_; }
   eprosima::fastdds::dds::Publisher& publisher() { return *publisher_; }
   eprosima::fastdds::dds::Subscriber& subscriber() { return *subscriber_; }
+  // A publisher / subscriber whose PartitionQosPolicy is exactly `partition` (created on first
+  // use, owned by this participant); "" is the partition-less default one. DDS Security grants
+  // each corner its measurements and health only in its own partition (docs/security.md).
+  eprosima::fastdds::dds::Publisher& publisher(const std::string& partition);
+  eprosima::fastdds::dds::Subscriber& subscriber(const std::string& partition);
   int domain_id() const { return domain_id_; }
 
   // The topic `name` of type PubSubT (registered on first use), owned by this participant.
@@ -77,6 +88,8 @@ class Participant {
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::map<std::string, eprosima::fastdds::dds::Publisher*> partition_publishers_;
+  std::map<std::string, eprosima::fastdds::dds::Subscriber*> partition_subscribers_;
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
   std::map<std::string, eprosima::fastdds::dds::ContentFilteredTopic*> filtered_;
 };

@@ -47,14 +47,19 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
 
   Reader(Participant& participant, const std::string& topic_name, const std::string& profile,
          Events& events, const ContentFilter* filter = nullptr)
-      : participant_(participant), events_(events) {
+      : Reader(participant, topic_name, profile, events, Partition{}, filter) {}
+
+  // `partition`: read through the participant's subscriber in that partition (docs/security.md).
+  Reader(Participant& participant, const std::string& topic_name, const std::string& profile,
+         Events& events, const Partition& partition, const ContentFilter* filter = nullptr)
+      : participant_(participant), subscriber_(participant.subscriber(partition.name)), events_(events) {
     auto& topic = participant.topic<PubSubT>(topic_name);
     eprosima::fastdds::dds::TopicDescription* description = &topic;
     if (filter != nullptr) {
       description = &participant.filtered_topic(topic, filter->filtered_topic_name,
                                                 filter->expression, filter->parameters);
     }
-    reader_ = participant.subscriber().create_datareader_with_profile(
+    reader_ = subscriber_.create_datareader_with_profile(
         description, profile, this, eprosima::fastdds::dds::StatusMask::all());
     if (reader_ == nullptr) {
       throw DdsError("cannot create DataReader on topic '" + topic_name + "' with profile '" +
@@ -63,7 +68,7 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
   }
   ~Reader() override {
     reader_->set_listener(nullptr);
-    participant_.subscriber().delete_datareader(reader_);
+    subscriber_.delete_datareader(reader_);
   }
   Reader(const Reader&) = delete;
   Reader& operator=(const Reader&) = delete;
@@ -175,6 +180,7 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
   }
 
   Participant& participant_;
+  eprosima::fastdds::dds::Subscriber& subscriber_;
   Events& events_;
   std::mutex event_mutex_;
   std::array<QosEvent, 64> event_queue_{};

@@ -19,11 +19,12 @@ class Writer : private eprosima::fastdds::dds::DataWriterListener {
   using Type = typename PubSubT::type;
 
   // `events` (must outlive the writer) is notified on matches and QoS events.
+  // `partition`: write through the participant's publisher in that partition (docs/security.md).
   Writer(Participant& participant, const std::string& topic_name, const std::string& profile,
-         Events& events)
-      : participant_(participant), events_(events) {
+         Events& events, const Partition& partition = {})
+      : participant_(participant), publisher_(participant.publisher(partition.name)), events_(events) {
     auto& topic = participant.topic<PubSubT>(topic_name);
-    writer_ = participant.publisher().create_datawriter_with_profile(
+    writer_ = publisher_.create_datawriter_with_profile(
         &topic, profile, this, eprosima::fastdds::dds::StatusMask::all());
     if (writer_ == nullptr) {
       throw DdsError("cannot create DataWriter on topic '" + topic_name + "' with profile '" +
@@ -32,7 +33,7 @@ class Writer : private eprosima::fastdds::dds::DataWriterListener {
   }
   ~Writer() override {
     writer_->set_listener(nullptr);
-    participant_.publisher().delete_datawriter(writer_);
+    publisher_.delete_datawriter(writer_);
   }
   Writer(const Writer&) = delete;
   Writer& operator=(const Writer&) = delete;
@@ -82,6 +83,7 @@ class Writer : private eprosima::fastdds::dds::DataWriterListener {
   }
 
   Participant& participant_;
+  eprosima::fastdds::dds::Publisher& publisher_;
   Events& events_;
   eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
   std::atomic<int> matched_{0};
