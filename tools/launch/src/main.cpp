@@ -441,6 +441,8 @@ int main(int argc, char** argv) {
           .value("force_command_samples", m.force_samples)
           .value("tracking_max_abs_error_kN", m.tracking_max_abs_error_kN)
           .value("tracking_rms_error_kN", m.tracking_rms_error_kN)
+          .value("tracking_steady_max_abs_error_kN", m.tracking_steady_max_abs_error_kN)
+          .value("tracking_steady_rms_error_kN", m.tracking_steady_rms_error_kN)
           .value("fits_accepted", static_cast<long long>(num(ccu, p + "fits_accepted", ccu_stats_file)))
           .value("fits_rejected", static_cast<long long>(num(ccu, p + "fits_rejected", ccu_stats_file)))
           .value("first_fit_time_s", num(ccu, p + "first_fit_time_s", ccu_stats_file))

@@ -23,14 +23,24 @@ CornerSummary summarize_corner(const std::string& corner, const csv::Table& log)
   const auto& fused = log.column("fused_kN");
   const auto& valid = log.column("valid");
   const auto& calibrated = log.column("calibrated");
+  const auto& time = log.column("time_s");
   s.samples = log.rows();
-  double fused_sq = 0.0, comp_sq = 0.0, lc_sq = 0.0, track_sq = 0.0;
+  double fused_sq = 0.0, comp_sq = 0.0, lc_sq = 0.0, track_sq = 0.0, steady_sq = 0.0;
+  double held_cmd = 0.0, held_since_s = 0.0;
   for (std::size_t i = 0; i < log.rows(); ++i) {
     if (force_mode[i] > 0.5) {
       const double e = truth[i] - cmd[i];
       track_sq += e * e;
       s.tracking_max_abs_error_kN = std::max(s.tracking_max_abs_error_kN, std::fabs(e));
       ++s.force_samples;
+      if (std::fabs(cmd[i] - held_cmd) > 0.05) {
+        held_cmd = cmd[i];
+        held_since_s = time[i];
+      } else if (time[i] - held_since_s >= 0.3 && cmd[i] > 0.5) {
+        steady_sq += e * e;
+        s.tracking_steady_max_abs_error_kN = std::max(s.tracking_steady_max_abs_error_kN, std::fabs(e));
+        ++s.steady_samples;
+      }
     }
     if (valid[i] < 0.5 || calibrated[i] < 0.5) continue;
     const double ef = fused[i] - truth[i];
@@ -50,6 +60,7 @@ CornerSummary summarize_corner(const std::string& corner, const csv::Table& log)
     s.load_cell_rms_error_kN = std::sqrt(lc_sq / n);
   }
   if (s.force_samples > 0) s.tracking_rms_error_kN = std::sqrt(track_sq / static_cast<double>(s.force_samples));
+  if (s.steady_samples > 0) s.tracking_steady_rms_error_kN = std::sqrt(steady_sq / static_cast<double>(s.steady_samples));
   return s;
 }
 

@@ -21,6 +21,11 @@ struct CornerSummary {
   double load_cell_rms_error_kN = 0.0;     // raw load cell vs truth, same samples
   std::size_t force_samples = 0;           // samples under a clamp-force command
   double tracking_rms_error_kN = 0.0;      // true clamp force vs command
+  // Holds only: samples whose command has stayed within 0.05 kN for 0.3 s (step transients,
+  // bounded by the actuator's speed, excluded) and is above 0.5 kN.
+  double tracking_steady_max_abs_error_kN = 0.0;
+  double tracking_steady_rms_error_kN = 0.0;
+  std::size_t steady_samples = 0;
   double tracking_max_abs_error_kN = 0.0;
 };
 
