@@ -286,7 +286,7 @@ TEST(CornerSim, VehicleStopTracksTheDemandSplit) {
   for (std::size_t c : {0u, 2u}) {
     scenario::CornerSim sim(s, c);
     const double expected = 0.9 * 40.0 * (c == 0 ? 1.0 : 0.4 / 0.6);
-    for (int i = 0; i < 9000; ++i) sim.step(s.plant_dt_s);  // t = 9 s: hard braking held
+    for (int i = 0; i < 17000; ++i) sim.step(s.plant_dt_s);  // t = 17 s: hard braking held
     EXPECT_NEAR(sim.last().command, expected, 1e-9);
     EXPECT_NEAR(sim.last().force_internal_kN, expected, 0.3);
   }
