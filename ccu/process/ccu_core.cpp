@@ -69,7 +69,7 @@ const SampleOutcome& CcuCore::on_sample(std::size_t slot, const faults::CornerRe
     o.estimate_kN = e.force_kN;
     o.friction_kN = e.friction_kN;
     o.curve_kN = e.curve_force_kN;
-    o.fused_kN = fuse(e, r.load_cell_kN, fusion_weight_);
+    o.fused_kN = v.force_estimate_kN;  // f_hat fused with the curve by its learned error (EstimateFusion)
     o.valid = true;
     o.from_calibrator = true;
   } else {
