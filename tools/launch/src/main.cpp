@@ -200,6 +200,13 @@ int main(int argc, char** argv) {
   const auto wall0 = Clock::now();
   const auto actions = bbw::faults::process_actions(schedule);
   const bool process_faults = !actions.empty();
+  // A corner restart runs every process on UDP over 127.0.0.1 without shared memory (profile
+  // bbw_localhost_udp in config/dds/bbw_profiles.xml explains why).
+  bool corner_restarts = false;
+  for (const auto& a : actions) corner_restarts |= a.kind == bbw::faults::ProcessAction::Kind::Restart;
+  const std::vector<std::string> profile_args =
+      corner_restarts ? std::vector<std::string>{"--dds-participant-profile", "bbw_localhost_udp"}
+                      : std::vector<std::string>{};
   // Where each corner's incarnations keep their stats and per-period log.
   auto corner_stats_file = [&](const std::string& c, unsigned n) {
     return out_dir + "/corner_" + c + (n == 0 ? "" : "." + std::to_string(n)) + ".stats";
@@ -217,6 +224,7 @@ int main(int argc, char** argv) {
       argv.insert(argv.end(), {"--peer-timeout", std::to_string(discovery_s + 10.0)});
     }
     if (secure) argv.insert(argv.end(), {"--secure", keys_dir});
+    argv.insert(argv.end(), profile_args.begin(), profile_args.end());
     if (incarnation > 0) {
       argv.insert(argv.end(), {"--incarnation", std::to_string(incarnation), "--resume-at", std::to_string(resume_at_s)});
     }
@@ -231,6 +239,7 @@ int main(int argc, char** argv) {
                                       "--out", out_dir, "--discovery-timeout", disc, "--friction-feedback", feedback};
     if (process_faults) ccu_argv.push_back("--process-faults");
     if (secure) ccu_argv.insert(ccu_argv.end(), {"--secure", keys_dir});
+    ccu_argv.insert(ccu_argv.end(), profile_args.begin(), profile_args.end());
     children.push_back(std::make_unique<Child>("bbw_ccu", ccu_argv, out_dir + "/ccu.out", out_dir + "/ccu.err"));
     for (const auto& c : scenario->corners) spawn_corner(c.name, 0, 0.0);
   } catch (const std::exception& e) {
