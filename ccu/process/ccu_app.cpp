@@ -2,6 +2,7 @@
 
 #include <signal.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -64,7 +65,7 @@ std::uint8_t feedback_code(const std::optional<corner_unit::ForceFeedback>& f) {
 const char* kCsvHeader =
     "time_s,seq,block_seq,position_rev,speed_rev_s,force_internal_kN,force_external_kN,force_true_kN,"
     "temperature_C,motor_current_A,command,force_mode,estimate_kN,friction_kN,curve_kN,fused_kN,valid,"
-    "calibrated,source,available\n";
+    "calibrated,source,available,accepted\n";
 
 }  // namespace
 
@@ -250,7 +251,10 @@ void CcuApp::process_block(CornerChannel& channel_of_partition, const msg::Measu
     ++ch->rejoins;
   }
   if (b.block_seq() != ch->next_block) ++ch->block_gaps;
-  ch->next_block = b.block_seq() + 1;
+  // Never backwards within an incarnation: an old or forged block number cannot make the
+  // lockstep clock wait again for a block it already has (it stalled the run until the peer
+  // timeout before).
+  ch->next_block = std::max(ch->next_block, b.block_seq() + 1);
   ++ch->blocks_received;
   if (!b.samples().empty() && b.samples().front().seq() != ch->next_sample_seq) {
     ch->sample_gaps += b.samples().front().seq() > ch->next_sample_seq ? b.samples().front().seq() - ch->next_sample_seq : 1;
@@ -261,18 +265,20 @@ void CcuApp::process_block(CornerChannel& channel_of_partition, const msg::Measu
     const faults::CornerReading r = reading_from(s);
     const std::uint64_t rejected_before = core_.supervisor(ch->slot).guard().rejected();
     const SampleOutcome& o = core_.on_sample(ch->slot, r, arrival_s);
-    if (core_.supervisor(ch->slot).guard().rejected() != rejected_before) ++ch->samples_invalid;
+    const bool accepted = core_.supervisor(ch->slot).guard().rejected() == rejected_before;
+    if (!accepted) ++ch->samples_invalid;
     if (ch->csv != nullptr) {
       // Shortest round-trip decimal form (std::to_chars): exact, and far cheaper than %.17g.
       char line[700];
       char* p = line;
       char* const last = line + sizeof(line);
+      // One character is kept back for each separator, so a full buffer truncates, never overflows.
       auto put = [&](double v) {
-        p = std::to_chars(p, last, v).ptr;
+        p = std::to_chars(p, last - 1, v).ptr;
         *p++ = ',';
       };
       auto put_u = [&](unsigned long long v) {
-        p = std::to_chars(p, last, v).ptr;
+        p = std::to_chars(p, last - 1, v).ptr;
         *p++ = ',';
       };
       put(s.time_s());
@@ -292,6 +298,7 @@ void CcuApp::process_block(CornerChannel& channel_of_partition, const msg::Measu
       put_u(o.calibrated ? 1 : 0);
       put_u(static_cast<unsigned long long>(core_.supervisor(ch->slot).view().source));
       put_u(core_.supervisor(ch->slot).view().available ? 1 : 0);
+      put_u(accepted ? 1 : 0);  // the sample guard let this sample through
       p[-1] = '\n';
       std::fwrite(line, 1, static_cast<std::size_t>(p - line), ch->csv);
     }
@@ -304,8 +311,14 @@ void CcuApp::drain_blocks(double arrival_s) {
   eprosima::fastdds::dds::SampleInfo info;
   const bool realtime = options_.mode == ClockMode::Realtime;
   for (std::size_t i = 0; i < channels_.size(); ++i) {
+    CornerChannel& ch = channels_[i];
     while (blocks_[i]->take(block_, info)) {
-      process_block(channels_[i], block_, info, realtime ? realtime_now_s() : arrival_s);
+      if (ch.block_tokens < 1.0) {
+        ++ch.blocks_over_rate;  // beyond the corner's rate: dropped unread
+        continue;
+      }
+      ch.block_tokens -= 1.0;
+      process_block(ch, block_, info, realtime ? realtime_now_s() : arrival_s);
     }
   }
 }
@@ -352,6 +365,9 @@ void CcuApp::record_detections() {
 }
 
 void CcuApp::after_period(double now_s) {
+  for (auto& ch : channels_) {
+    ch.block_tokens = std::min(CornerChannel::kBlockBurst, ch.block_tokens + CornerChannel::kBlocksPerPeriod);
+  }
   core_.tick(now_s);
   record_detections();
 }
@@ -531,6 +547,7 @@ void CcuApp::write_stats(const std::string& file) const {
     w.set(p + "samples_invalid", static_cast<unsigned long long>(ch.samples_invalid));
     w.set(p + "foreign_blocks", static_cast<unsigned long long>(ch.foreign_blocks));
     w.set(p + "foreign_health", static_cast<unsigned long long>(ch.foreign_health));
+    w.set(p + "blocks_over_rate", static_cast<unsigned long long>(ch.blocks_over_rate));
     w.set(p + "block_gaps", static_cast<unsigned long long>(ch.block_gaps));
     w.set(p + "sample_gaps", static_cast<unsigned long long>(ch.sample_gaps));
     w.set(p + "rejoins", static_cast<unsigned long long>(ch.rejoins));

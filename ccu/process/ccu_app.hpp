@@ -72,6 +72,14 @@ struct CornerChannel {
   // or a corner id that does not exist): dropped before anything reads them.
   std::uint64_t foreign_blocks = 0;
   std::uint64_t foreign_health = 0;
+  // Flood guard: a token bucket of blocks this corner may still have processed (refilled by
+  // kBlocksPerPeriod every CCU period up to kBlockBurst); blocks beyond it are taken and dropped
+  // unread, so a corner sending at many times its rate cannot take the CCU's time from the
+  // others (docs/security.md, "Flooding").
+  static constexpr double kBlocksPerPeriod = 2.0;
+  static constexpr double kBlockBurst = 40.0;
+  double block_tokens = kBlockBurst;
+  std::uint64_t blocks_over_rate = 0;
   std::uint64_t block_gaps = 0;        // blocks missing or out of order (within an incarnation)
   std::uint64_t sample_gaps = 0;       // samples missing between consecutive blocks (within one)
   std::uint64_t rejoins = 0;           // new incarnations seen

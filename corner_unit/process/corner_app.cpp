@@ -112,13 +112,15 @@ void CornerApp::publish_health(std::uint8_t status) {
 }
 
 bool CornerApp::wait_for_ccu(std::string& error) {
-  const bool ok = events_.wait_for(options_.discovery_timeout, [&] {
+  const auto timeout = options_.match_timeout.count() > 0 ? options_.match_timeout : options_.discovery_timeout;
+  const bool ok = events_.wait_for(timeout, [&] {
     return blocks_.matched() >= 1 && commands_.matched() >= 1 && calibration_.matched() >= 1 &&
            health_.matched() >= 1;
   });
+  matched_ccu_ = ok;
   if (!ok && !events_.interrupted()) {
     error = std::string("CCU not discovered within ") +
-            std::to_string(options_.discovery_timeout.count()) + " ms (measurement readers matched: " +
+            std::to_string(timeout.count()) + " ms (measurement readers matched: " +
             std::to_string(blocks_.matched()) + ", command writers matched: " +
             std::to_string(commands_.matched()) + ")";
   }

@@ -35,6 +35,12 @@ struct CornerOptions {
   ClockMode mode = ClockMode::Lockstep;
   dds::ParticipantOptions participant;
   std::chrono::milliseconds discovery_timeout{20000};
+  // Longest wait for the CCU's endpoints to match (0: discovery_timeout). With DDS Security
+  // main() sets a shorter one and, when it passes, starts over with a new participant: Fast
+  // DDS 2.9 sometimes loses the security handshake of one pair when several participants start
+  // together and never retries it (a race in its SecurityManager, fixed upstream after 2.9,
+  // eProsima/Fast-DDS#4188); a new participant is a new handshake.
+  std::chrono::milliseconds match_timeout{0};
   std::chrono::milliseconds peer_timeout{10000};  // lockstep: longest wait for the next command
   std::string stats_file;                        // JSON with counters and jitter; "" for none
   std::string periods_log;                       // per-period CSV (truth, applied command); "" for none
@@ -96,6 +102,7 @@ class CornerApp {
   // `error` explains a non-zero result.
   int run(std::string& error);
   const CornerStats& stats() const { return stats_; }
+  bool matched_ccu() const { return matched_ccu_; }  // the CCU's endpoints matched at least once
   void write_stats(const std::string& file) const;  // key=value (bbw/launch/stats_file.hpp)
 
  private:
@@ -131,6 +138,7 @@ class CornerApp {
   std::FILE* periods_csv_ = nullptr;
   bool ccu_lost_ = false;   // lockstep: the corner runs on alone
   bool started_ = false;
+  bool matched_ccu_ = false;
   double jitter_sum_s_ = 0.0;
 
   msg::MeasurementBlock block_;

@@ -16,10 +16,13 @@
 //
 // Exit: 0 done (or stopped by SIGINT/SIGTERM: 130/143), 1 runtime or DDS error, 2 bad
 // arguments or config, 3 CCU not discovered in time, 4 CCU lost (no command in time).
+#include <algorithm>
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -138,13 +141,30 @@ int main(int argc, char** argv) {
   int rc = kExitOk;
   std::string error;
   try {
-    CornerApp app(*scenario, opt, events);
-    std::cout << "bbw_corner " << corner_arg << ": domain " << opt.participant.domain_id << ", mode " << mode
-              << ", scenario " << scenario->name << std::endl;
-    rc = app.run(error);
-    if (!opt.stats_file.empty()) app.write_stats(opt.stats_file);
-    std::cout << "bbw_corner " << corner_arg << ": " << app.stats().periods << " periods, "
-              << app.stats().samples_published << " samples published" << std::endl;
+    // With security: a new participant when the CCU has not matched within 5 s (see
+    // CornerOptions::match_timeout), until the discovery deadline.
+    const auto discovery_deadline = std::chrono::steady_clock::now() + opt.discovery_timeout;
+    std::unique_ptr<CornerApp> app;
+    for (int attempt = 1;; ++attempt) {
+      const auto remaining = std::chrono::duration_cast<std::chrono::milliseconds>(
+          discovery_deadline - std::chrono::steady_clock::now());
+      CornerOptions o = opt;
+      const bool retry = !secure_dir.empty() && remaining > std::chrono::milliseconds(6000);
+      o.match_timeout = retry ? std::chrono::milliseconds(5000) : std::max(remaining, std::chrono::milliseconds(1));
+      app.reset();  // the old participant goes before the new one exists
+      app = std::make_unique<CornerApp>(*scenario, o, events);
+      if (attempt == 1) {
+        std::cout << "bbw_corner " << corner_arg << ": domain " << opt.participant.domain_id << ", mode " << mode
+                  << ", scenario " << scenario->name << std::endl;
+      }
+      rc = app->run(error);
+      if (!(retry && rc == kExitDiscovery && !app->matched_ccu() && !events.interrupted())) break;
+      std::cerr << "bbw_corner " << corner_arg << ": CCU not matched within 5 s (attempt " << attempt
+                << "), joining again with a new participant" << std::endl;
+    }
+    if (!opt.stats_file.empty()) app->write_stats(opt.stats_file);
+    std::cout << "bbw_corner " << corner_arg << ": " << app->stats().periods << " periods, "
+              << app->stats().samples_published << " samples published" << std::endl;
   } catch (const std::invalid_argument& e) {
     std::cerr << "bbw_corner " << corner_arg << ": " << e.what() << "\n";
     return kExitUsage;

@@ -4,6 +4,7 @@
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/dds/log/Log.hpp>
 #include <fastdds/dds/publisher/qos/PublisherQos.hpp>
 #include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
 
@@ -44,6 +45,14 @@ void load_profiles(const std::string& file) {
 
 Participant::Participant(const ParticipantOptions& options) : domain_id_(options.domain_id) {
   auto* factory = fdds::DomainParticipantFactory::get_instance();
+  // Diagnostics: env BBW_DDS_LOG=warning|info raises Fast DDS's log verbosity (errors only by
+  // default; info messages exist only in Fast DDS builds with them compiled in).
+  if (const char* log = std::getenv("BBW_DDS_LOG"); log != nullptr && *log != '\0') {
+    const std::string level = log;
+    fdds::Log::SetVerbosity(level == "info" ? fdds::Log::Kind::Info
+                            : level == "warning" ? fdds::Log::Kind::Warning
+                                                 : fdds::Log::Kind::Error);
+  }
   // Content filters need the TypeObjects, which are otherwise registered only when a message
   // object is first constructed.
   registerbbw_msgsTypes();

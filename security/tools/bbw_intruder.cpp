@@ -7,6 +7,7 @@
 // Each command asks for --force-kN on every corner (valid, force mode) so that a run whose
 // corners ever apply one is easy to spot. One JSON line on stdout reports what happened:
 //   {"as":"rogue","participant":true,"writer":true,"max_matched":0,"written":600}
+// SIGINT/SIGTERM end the attempt before --duration-s (the JSON line is still printed).
 // Exit 0 when the attempt ran (refusals are results, not errors), 2 on bad usage, 1 otherwise.
 //
 // --measurements flood|hostile writes measurement blocks instead of commands, as corner
@@ -40,6 +41,7 @@
 #include "bbw/dds/participant.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/dds/writer.hpp"
+#include "bbw/launch/signals.hpp"
 #include "bbw/security/dds_security.hpp"
 
 namespace {
@@ -67,6 +69,7 @@ struct Options {
 // What the measurement modes wrote.
 struct BlockCounts {
   std::uint64_t blocks = 0, foreign = 0, unknown = 0, bad_samples = 0;
+  int max_matched = 0;
 };
 
 // One plausible rig sample (passes the CCU's sample guard).
@@ -94,7 +97,7 @@ BlockCounts write_blocks(bbw::dds::Writer<BlockT>& w, bbw::dds::Events& events, 
   std::uint64_t seq = 0, block = 0, tick_n = 0;
   bbw::msg::MeasurementBlock b;
   auto tick = std::chrono::steady_clock::now();
-  while (std::chrono::steady_clock::now() < end) {
+  while (std::chrono::steady_clock::now() < end && !events.interrupted()) {
     const int count = o.measurements == "flood" ? o.rate_x : 1;
     for (int i = 0; i < count; ++i) {
       b.corner_id(corner_id);
@@ -124,6 +127,7 @@ BlockCounts write_blocks(bbw::dds::Writer<BlockT>& w, bbw::dds::Events& events, 
         else if (o.measurements == "hostile") ++n.bad_samples;
       }
     }
+    n.max_matched = std::max(n.max_matched, w.matched());
     ++tick_n;
     tick += std::chrono::milliseconds(5);
     events.wait_until(std::min(tick, end), [] { return false; });
@@ -197,6 +201,10 @@ bbw::dds::ParticipantOptions participant_options(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // SIGINT/SIGTERM end the attempt early, still with its JSON line (tests stop an intruder
+  // when the run it attacked is over).
+  bbw::dds::Events events;
+  bbw::launch::SignalWatcher signals([&](int) { events.interrupt(); });
   Options o;
   try {
     o = parse(argc, argv);
@@ -211,7 +219,6 @@ int main(int argc, char** argv) {
   BlockCounts blocks;
   std::string refused;
   try {
-    bbw::dds::Events events;
     bbw::dds::Participant participant(participant_options(o));
     participant_ok = true;
     std::unique_ptr<bbw::dds::Writer<CommandT>> writer;
@@ -234,7 +241,7 @@ int main(int argc, char** argv) {
         // Write only once a reader listens (the CCU), within the duration.
         bw->wait_for_matched(1, end - std::chrono::steady_clock::now());
         blocks = write_blocks(*bw, events, o, static_cast<std::uint8_t>(corner_id), end);
-        max_matched = bw->matched();
+        max_matched = blocks.max_matched;
         written = blocks.blocks;
         bw->get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
       }
@@ -252,7 +259,7 @@ int main(int argc, char** argv) {
                                    std::chrono::duration<double>(o.duration_s));
       auto tick = start;
       std::uint64_t seq = 0;
-      while (std::chrono::steady_clock::now() < end) {
+      while (std::chrono::steady_clock::now() < end && !events.interrupted()) {
         for (std::uint8_t c = 0; c < 4; ++c) {
           bbw::msg::ClampCommand cmd;
           cmd.corner_id(c);

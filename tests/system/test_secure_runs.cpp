@@ -1,0 +1,328 @@
+// The whole system under DDS Security (issue 7, docs/security.md) and hostile DDS input:
+// bbw_launch --secure with real bbw_ccu / bbw_corner processes and bbw_intruder next to them.
+// Domains 221-226, one per test. Every run and every intruder is bounded (launcher wall-time
+// bound, intruder --duration-s, waits with deadlines); nothing sleeps.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "bbw/launch/child.hpp"
+#include "bbw/launch/stats_file.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+std::string src(const std::string& rel) { return std::string(BBW_TEST_SOURCE_DIR) + "/" + rel; }
+std::string bin(const std::string& name) { return std::string(BBW_TEST_BINARY_DIR) + "/bin/" + name; }
+
+const char* kCorners[] = {"FL", "FR", "RL", "RR"};
+constexpr double kIntruderForce = 77.7;  // kN: no scenario commands it, so it is easy to spot
+
+std::string slurp(const std::string& file) {
+  std::ifstream f(file);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+std::string scratch(const std::string& test) {
+  const fs::path p = fs::temp_directory_path() / ("bbw_secure_" + test + "_" + std::to_string(::getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+struct ProcessRun {
+  bbw::launch::ExitStatus status;
+  std::string out, err;
+};
+
+// BBW_DDS_LOG=warning: a failed handshake or discovery leaves Fast DDS's warnings in the
+// children's .err files (nothing is printed when all goes well).
+ProcessRun run(const std::string& name, const std::vector<std::string>& argv, const std::string& dir,
+               std::chrono::seconds limit) {
+  bbw::launch::Child child(name, argv, dir + "/" + name + ".stdout", dir + "/" + name + ".stderr",
+                           {"BBW_DDS_LOG=warning"});
+  auto status = child.wait_until(Clock::now() + limit);
+  if (!status) status = child.stop(2000ms);
+  return {*status, slurp(dir + "/" + name + ".stdout"), slurp(dir + "/" + name + ".stderr")};
+}
+
+std::vector<std::string> launch_argv(const std::string& dir, int domain, const std::string& mode, bool secure) {
+  std::vector<std::string> a{bin("bbw_launch"), src("tests/system/data/short_rig.yaml"), "--out", dir + "/out",
+                             "--mode", mode, "--domain", std::to_string(domain), "--discovery-timeout", "20",
+                             "--no-report"};
+  if (secure) a.insert(a.end(), {"--secure", "--keys", dir + "/keys"});
+  return a;
+}
+
+ProcessRun launch(const std::string& dir, int domain, const std::string& mode, bool secure) {
+  return run("bbw_launch", launch_argv(dir, domain, mode, secure), dir, 150s);
+}
+
+double stat(const std::string& file, const std::string& key) {
+  return bbw::launch::stat_number(bbw::launch::read_stats(file), key, file);
+}
+
+// A CSV file as rows of numbers by column name ("nan", "inf" parse as such).
+struct Table {
+  std::map<std::string, std::size_t> col;
+  std::vector<std::vector<double>> rows;
+  double at(std::size_t r, const std::string& name) const { return rows[r][col.at(name)]; }
+};
+
+Table read_table(const std::string& file) {
+  Table t;
+  std::ifstream f(file);
+  std::string line, cell;
+  if (!std::getline(f, line)) return t;
+  std::stringstream h(line);
+  for (std::size_t i = 0; std::getline(h, cell, ','); ++i) t.col[cell] = i;
+  while (std::getline(f, line)) {
+    std::vector<double> row;
+    std::stringstream ls(line);
+    while (std::getline(ls, cell, ',')) row.push_back(std::strtod(cell.c_str(), nullptr));
+    if (row.size() == t.col.size()) t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+
+// Periods in which a corner applied the intruder's force.
+std::size_t periods_with_intruder_force(const std::string& out, const std::string& corner) {
+  const Table t = read_table(out + "/corner_" + corner + "_periods.csv");
+  std::size_t n = 0;
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    if (std::fabs(t.at(r, "applied_kN") - kIntruderForce) < 1e-6) ++n;
+  }
+  return n;
+}
+
+// One bbw_intruder process, started now, reporting one JSON line at its end.
+class Intruder {
+ public:
+  Intruder(const std::string& dir, const std::string& name, std::vector<std::string> args)
+      : dir_(dir), name_(name) {
+    args.insert(args.begin(), bin("bbw_intruder"));
+    child_ = std::make_unique<bbw::launch::Child>(name, args, dir + "/" + name + ".stdout", dir + "/" + name + ".stderr");
+  }
+  bool running() { return !child_->poll().has_value(); }
+  // Stops it (SIGTERM ends its attempt), waits (bounded) for the end; the JSON line it printed.
+  std::string finish(std::chrono::seconds limit) {
+    if (running()) child_->send_signal(SIGTERM);
+    auto st = child_->wait_until(Clock::now() + limit);
+    if (!st) st = child_->stop(2000ms);
+    EXPECT_TRUE(st->ok()) << name_ << ": " << st->describe() << "\n" << slurp(dir_ + "/" + name_ + ".stderr");
+    return slurp(dir_ + "/" + name_ + ".stdout");
+  }
+
+ private:
+  std::string dir_, name_;
+  std::unique_ptr<bbw::launch::Child> child_;
+};
+
+// "key":number from the intruder's JSON line (-1 when absent).
+double json_number(const std::string& json, const std::string& key) {
+  const auto p = json.find("\"" + key + "\":");
+  if (p == std::string::npos) return -1.0;
+  return std::strtod(json.c_str() + p + key.size() + 3, nullptr);
+}
+bool json_true(const std::string& json, const std::string& key) {
+  return json.find("\"" + key + "\":true") != std::string::npos;
+}
+
+void make_keys(const std::string& dir) {
+  const ProcessRun k = run("bbw-keys", {src("scripts/bbw-keys.sh"), dir + "/keys"}, dir, 120s);
+  ASSERT_TRUE(k.status.ok()) << k.status.describe() << "\n" << k.err;
+}
+
+// The launcher checks as the system tests do: every sample and command arrived, nothing else.
+void expect_clean_lockstep_run(const std::string& out) {
+  const std::string ccu = out + "/ccu.stats";
+  EXPECT_EQ(stat(ccu, "periods_done"), 800.0);
+  EXPECT_EQ(stat(ccu, "foreign_corner_samples"), 0.0);
+  EXPECT_EQ(stat(ccu, "unknown_corner_blocks"), 0.0);
+  for (const char* c : kCorners) {
+    const std::string p = std::string(c) + ".";
+    const std::string cs = out + "/corner_" + c + ".stats";
+    EXPECT_EQ(stat(ccu, p + "samples_received"), 4000.0) << c;
+    EXPECT_EQ(stat(ccu, p + "block_gaps"), 0.0) << c;
+    EXPECT_EQ(stat(ccu, p + "sample_gaps"), 0.0) << c;
+    EXPECT_EQ(stat(ccu, p + "samples_invalid"), 0.0) << c;
+    EXPECT_EQ(stat(cs, "commands_applied"), 800.0) << c;
+    EXPECT_EQ(stat(cs, "command_seq_gaps"), 0.0) << c;
+  }
+}
+
+// Domains 221 (without security) and 222 (with): the short lockstep scenario gives the same
+// result byte for byte; the launcher creates the missing keys itself.
+TEST(SystemSecure, LockstepRunEqualsTheRunWithoutSecurity) {
+  const std::string plain = scratch("plain");
+  const std::string secure = scratch("secure");
+  const ProcessRun a = launch(plain, 221, "lockstep", false);
+  ASSERT_TRUE(a.status.ok()) << a.status.describe() << "\n" << a.out << a.err;
+  ASSERT_FALSE(fs::exists(secure + "/keys"));
+  const ProcessRun b = launch(secure, 222, "lockstep", true);
+  ASSERT_TRUE(b.status.ok()) << b.status.describe() << "\n" << b.out << b.err;
+  EXPECT_NE(b.out.find("creating DDS Security keys"), std::string::npos) << b.out;
+  EXPECT_TRUE(fs::exists(secure + "/keys/ccu/permissions.p7s"));
+  EXPECT_NE(slurp(secure + "/out/summary.json").find("\"secure\": true"), std::string::npos);
+  EXPECT_NE(slurp(plain + "/out/summary.json").find("\"secure\": false"), std::string::npos);
+  // The children really ran with security (their command lines carry the keys directory).
+  expect_clean_lockstep_run(secure + "/out");
+  for (const char* c : kCorners) {
+    const std::string la = slurp(plain + "/out/ccu_" + std::string(c) + ".csv");
+    const std::string lb = slurp(secure + "/out/ccu_" + std::string(c) + ".csv");
+    ASSERT_GT(la.size(), 100000u) << c;
+    EXPECT_TRUE(la == lb) << "corner " << c << ": the CCU's log with security differs from the one without";
+  }
+  fs::remove_all(plain);
+  fs::remove_all(secure);
+}
+
+// Domain 223: while a secure lockstep run goes on from start to end, three intruders try to
+// command every corner with 77.7 kN: unsecured, with a rogue CA's certificate, and as a
+// certified corner (FL) whose permissions grant no commands. None matches; no corner ever
+// applies the force; the run is as clean as without them.
+TEST(SystemSecure, IntrudersNeverCommandACornerOfASecureRun) {
+  const std::string dir = scratch("intruders");
+  make_keys(dir);
+  const std::string keys = dir + "/keys";
+  const std::vector<std::string> common{"--keys", keys, "--domain", "223", "--duration-s", "60", "--force-kN", "77.7"};
+  auto args = [&](std::vector<std::string> a) {
+    a.insert(a.end(), common.begin(), common.end());
+    return a;
+  };
+  Intruder none(dir, "intruder_none", args({"--as", "none"}));
+  Intruder rogue(dir, "intruder_rogue", args({"--as", "rogue"}));
+  Intruder corner(dir, "intruder_corner", args({"--as", "corner", "--corner", "FL"}));
+  const ProcessRun r = launch(dir, 223, "lockstep", true);
+  // The intruders were there for the whole run.
+  EXPECT_TRUE(none.running() && rogue.running()) << "the run outlasted the intruders: make --duration-s longer";
+  ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
+  expect_clean_lockstep_run(dir + "/out");
+  for (const char* c : kCorners) {
+    EXPECT_EQ(periods_with_intruder_force(dir + "/out", c), 0u) << "corner " << c << " applied the intruder's force";
+  }
+  const std::string jn = none.finish(20s), jr = rogue.finish(20s), jc = corner.finish(20s);
+  for (const std::string* j : {&jn, &jr}) {
+    EXPECT_TRUE(json_true(*j, "participant") && json_true(*j, "writer")) << *j;
+    EXPECT_GT(json_number(*j, "written"), 1000.0) << *j;
+    EXPECT_EQ(json_number(*j, "max_matched"), 0.0) << *j;
+  }
+  EXPECT_TRUE(json_true(jc, "participant")) << jc;
+  EXPECT_FALSE(json_true(jc, "writer")) << "access control let corner FL write commands: " << jc;
+  EXPECT_EQ(json_number(jc, "max_matched"), 0.0) << jc;
+  fs::remove_all(dir);
+}
+
+// Domain 224, the positive control of the test above: without security the same unsecured
+// intruder does reach the corners, which then apply its force (so the checks above can fail).
+TEST(SystemSecure, WithoutSecurityAnIntruderCommandsTheCorners) {
+  const std::string dir = scratch("unprotected");
+  Intruder none(dir, "intruder_none", {"--as", "none", "--domain", "224", "--duration-s", "60", "--force-kN", "77.7"});
+  const ProcessRun r = launch(dir, 224, "lockstep", false);
+  EXPECT_TRUE(none.running());
+  ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
+  std::size_t applied = 0;
+  for (const char* c : kCorners) applied += periods_with_intruder_force(dir + "/out", c);
+  EXPECT_GT(applied, 0u) << "an unsecured intruder's command was never applied: the check cannot see one";
+  const std::string j = none.finish(20s);
+  EXPECT_GE(json_number(j, "max_matched"), 4.0) << j;
+  fs::remove_all(dir);
+}
+
+// Domain 225: a publisher as corner FL (in FL's partition, unsecured: the CCU treats it as a
+// compromised certified FL) sends malformed blocks through a realtime run: NaN and infinite
+// values, values out of range, a sequence going backwards, FR's corner id, corner id 7. The
+// CCU drops the foreign and unknown ids (counted) and never uses a bad sample as valid; the
+// other corners are untouched.
+TEST(SystemHostileInput, MalformedMeasurementsAreRejectedAndCounted) {
+  const std::string dir = scratch("hostile");
+  Intruder hostile(dir, "intruder_hostile",
+                   {"--as", "none", "--corner", "FL", "--measurements", "hostile", "--domain", "225", "--duration-s", "60"});
+  const ProcessRun r = launch(dir, 225, "realtime", false);
+  ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
+  const std::string j = hostile.finish(20s);
+  ASSERT_GE(json_number(j, "max_matched"), 1.0) << j;
+  const std::string out = dir + "/out", ccu = out + "/ccu.stats";
+  EXPECT_GT(stat(ccu, "FL.foreign_blocks"), 0.0);
+  EXPECT_GT(stat(ccu, "unknown_corner_blocks"), 0.0);
+  EXPECT_LE(stat(ccu, "FL.foreign_blocks"), json_number(j, "foreign") + json_number(j, "unknown"));
+  EXPECT_GT(stat(ccu, "FL.samples_invalid"), 0.0);
+  // FR's id in FL's partition never reached FR; the other corners saw exactly their own data.
+  for (const char* c : {"FR", "RL", "RR"}) {
+    const std::string p = std::string(c) + ".";
+    EXPECT_EQ(stat(ccu, p + "foreign_blocks"), 0.0) << c;
+    EXPECT_EQ(stat(ccu, p + "samples_invalid"), 0.0) << c;
+    EXPECT_EQ(stat(ccu, p + "samples_received"), stat(out + "/corner_" + c + ".stats", "samples_published")) << c;
+  }
+  // Every sample the CCU logged for FL: a bad value is never valid; valid samples move forward.
+  const Table t = read_table(out + "/ccu_FL.csv");
+  ASSERT_GT(t.rows.size(), 100u);
+  std::size_t bad = 0, bad_accepted = 0, backwards_accepted = 0;
+  double last_seq = -1.0, last_time = -1e300;
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    const double x = t.at(i, "position_rev"), f = t.at(i, "force_internal_kN");
+    const bool is_bad = !std::isfinite(x) || std::isinf(f) || x > 10.0 || x < -1.0 || f > 80.0;
+    const bool accepted = t.at(i, "accepted") == 1.0;  // let through by the CCU's sample guard
+    if (is_bad) ++bad;
+    if (is_bad && accepted) ++bad_accepted;
+    if (accepted) {
+      if (!(t.at(i, "seq") > last_seq) || !(t.at(i, "time_s") > last_time)) ++backwards_accepted;
+      last_seq = t.at(i, "seq");
+      last_time = t.at(i, "time_s");
+    }
+  }
+  EXPECT_GT(bad, 0u) << "no malformed sample reached the CCU: the test proves nothing";
+  EXPECT_EQ(bad_accepted, 0u) << "malformed samples were accepted";
+  EXPECT_EQ(backwards_accepted, 0u) << "an accepted sample went backwards in sequence or time";
+  fs::remove_all(dir);
+}
+
+// Domain 226: a publisher as corner FL floods the CCU with plausible measurement blocks at 20
+// times a corner's rate for the whole realtime run. Criterion (docs/security.md, "Flooding"):
+// the other corners' commands are never late beyond their 20 ms deadline (no command deadline
+// missed on FR, RL, RR) and the CCU receives every one of their blocks in order, while it did
+// receive at least 10 times FL's normal number of blocks.
+TEST(SystemHostileInput, AFloodingCornerDoesNotDelayTheOthersCommands) {
+  const std::string dir = scratch("flood");
+  Intruder flood(dir, "intruder_flood", {"--as", "none", "--corner", "FL", "--measurements", "flood", "--rate-x", "20",
+                                         "--domain", "226", "--duration-s", "60"});
+  const ProcessRun r = launch(dir, 226, "realtime", false);
+  EXPECT_TRUE(flood.running()) << "the flood ended before the run";
+  ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
+  const std::string out = dir + "/out", ccu = out + "/ccu.stats";
+  // The flood reached the CCU (processed up to FL's budget, the rest dropped unread).
+  EXPECT_GE(stat(ccu, "FL.blocks_received") + stat(ccu, "FL.blocks_over_rate"), 10.0 * 800.0)
+      << "the flood did not reach the CCU";
+  EXPECT_GT(stat(ccu, "FL.blocks_over_rate"), 0.0);
+  for (const char* c : {"FR", "RL", "RR"}) {
+    const std::string p = std::string(c) + ".";
+    const std::string cs = out + "/corner_" + c + ".stats";
+    EXPECT_EQ(stat(cs, "command_deadlines_missed"), 0.0) << c;
+    EXPECT_EQ(stat(ccu, p + "blocks_received"), 800.0) << c;
+    EXPECT_EQ(stat(ccu, p + "block_gaps"), 0.0) << c;
+    EXPECT_EQ(stat(ccu, p + "deadlines_missed"), 0.0) << c;
+    std::cout << c << ": command deadline misses " << stat(cs, "command_deadlines_missed") << ", max jitter "
+              << stat(cs, "max_jitter_s") * 1e3 << " ms, overruns " << stat(cs, "overruns") << "\n";
+  }
+  flood.finish(20s);
+  fs::remove_all(dir);
+}
+
+}  // namespace
