@@ -2,6 +2,8 @@
 // corners, 5 ms CCU period, 20 s simulated) as five processes over the default transport.
 // Manual time = the CCU's wall time from the first command to the last block; counters:
 // real_time_factor = simulated / wall, and the CCU's and corners' CPU seconds are in the logs.
+// BM_LockstepFourCornerRigSecure: the same with ./bbw run --secure (keys from env
+// BBW_BENCH_KEYS, default keys/ in the repository; the launcher creates them if missing).
 // Domain: env BBW_BENCH_DOMAIN (default 202).
 #include <benchmark/benchmark.h>
 
@@ -9,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "bbw/launch/child.hpp"
 #include "bbw/launch/stats_file.hpp"
@@ -17,7 +20,7 @@ namespace {
 
 using namespace std::chrono_literals;
 
-void BM_LockstepFourCornerRig(benchmark::State& state) {
+void lockstep_rig(benchmark::State& state, bool secure) {
   const char* env = std::getenv("BBW_BENCH_DOMAIN");
   const std::string domain = env ? env : "202";
   const std::string out = (std::filesystem::temp_directory_path() / "bbw_bench_lockstep").string();
@@ -28,11 +31,14 @@ void BM_LockstepFourCornerRig(benchmark::State& state) {
   for (auto _ : state) {
     std::filesystem::remove_all(out);
     std::filesystem::create_directories(out);
-    bbw::launch::Child launch("bbw_launch",
-                              {bbw::launch::executable_dir() + "/bbw_launch",
-                               std::string(BBW_SOURCE_DIR) + "/config/scenarios/four_corner_rig.yaml", "--out",
-                               out + "/out", "--mode", "lockstep", "--domain", domain, "--no-report"},
-                              out + "/launch.out", out + "/launch.err");
+    std::vector<std::string> argv{bbw::launch::executable_dir() + "/bbw_launch",
+                                  std::string(BBW_SOURCE_DIR) + "/config/scenarios/four_corner_rig.yaml", "--out",
+                                  out + "/out", "--mode", "lockstep", "--domain", domain, "--no-report"};
+    if (secure) {
+      const char* keys = std::getenv("BBW_BENCH_KEYS");
+      argv.insert(argv.end(), {"--secure", "--keys", keys && *keys ? keys : std::string(BBW_SOURCE_DIR) + "/keys"});
+    }
+    bbw::launch::Child launch("bbw_launch", argv, out + "/launch.out", out + "/launch.err");
     const auto status = launch.wait_until(std::chrono::steady_clock::now() + 300s);
     if (!status || !status->ok()) {
       state.SkipWithError("bbw_launch failed; see /tmp/bbw_bench_lockstep/launch.err");
@@ -52,6 +58,10 @@ void BM_LockstepFourCornerRig(benchmark::State& state) {
   }
 }
 
+void BM_LockstepFourCornerRig(benchmark::State& state) { lockstep_rig(state, false); }
+void BM_LockstepFourCornerRigSecure(benchmark::State& state) { lockstep_rig(state, true); }
+
 }  // namespace
 
+BENCHMARK(BM_LockstepFourCornerRigSecure)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(3);
 BENCHMARK(BM_LockstepFourCornerRig)->UseManualTime()->Unit(benchmark::kSecond)->Iterations(3);

@@ -3,6 +3,9 @@
 // benchmark and of the two-process DDS system test.
 //
 //   bbw_dds_echo [--domain N] [--mode lockstep|realtime] [--max-blocks K]
+//                [--partition P] [--secure KEYS_DIR]
+// --partition: read the blocks in partition P (e.g. corner_*, as bbw_ccu reads corner_FL...);
+// --secure: DDS Security with the CCU's identity from KEYS_DIR (docs/security.md).
 // Exits 0 after K blocks (if given) or on SIGINT/SIGTERM; 2 on bad arguments; 1 on DDS errors.
 #include <bbw/idl/bbw_msgsPubSubTypes.h>
 
@@ -18,6 +21,7 @@
 #include "bbw/dds/topics.hpp"
 #include "bbw/dds/writer.hpp"
 #include "bbw/launch/signals.hpp"
+#include "bbw/security/dds_security.hpp"
 
 int main(int argc, char** argv) {
   bbw::dds::Events events;
@@ -25,17 +29,23 @@ int main(int argc, char** argv) {
   std::optional<std::string> domain_arg;
   std::string mode = "realtime";
   long long max_blocks = -1;
+  std::string partition, secure_dir;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--domain" && i + 1 < argc) {
       domain_arg = argv[++i];
     } else if (a == "--mode" && i + 1 < argc) {
       mode = argv[++i];
+    } else if (a == "--partition" && i + 1 < argc) {
+      partition = argv[++i];
+    } else if (a == "--secure" && i + 1 < argc) {
+      secure_dir = argv[++i];
     } else if (a == "--max-blocks" && i + 1 < argc) {
       max_blocks = std::atoll(argv[++i]);
     } else {
       std::cerr << "bbw_dds_echo: unknown argument '" << a << "'\n"
-                << "usage: bbw_dds_echo [--domain N] [--mode lockstep|realtime] [--max-blocks K]\n";
+                << "usage: bbw_dds_echo [--domain N] [--mode lockstep|realtime] [--max-blocks K]\n"
+                << "                    [--partition P] [--secure KEYS_DIR]\n";
       return 2;
     }
   }
@@ -49,9 +59,14 @@ int main(int argc, char** argv) {
     bbw::dds::ParticipantOptions opt;
     opt.domain_id = domain;
     opt.name = "bbw_dds_echo";
+    if (!secure_dir.empty()) {
+      opt.properties = bbw::security::participant_properties(
+          bbw::security::files_for(secure_dir, bbw::security::kCcuIdentity));
+    }
     bbw::dds::Participant participant(opt);
     bbw::dds::Reader<bbw::msg::MeasurementBlockPubSubType> blocks(
-        participant, bbw::dds::kMeasurementTopic, profiles.measurement_reader, events);
+        participant, bbw::dds::kMeasurementTopic, profiles.measurement_reader, events,
+        bbw::dds::Partition{partition});
     bbw::dds::Writer<bbw::msg::ClampCommandPubSubType> commands(
         participant, bbw::dds::kCommandTopic, profiles.command_writer, events);
     std::cout << "bbw_dds_echo: domain " << domain << ", mode " << mode << ", waiting" << std::endl;
