@@ -74,7 +74,7 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
     : scenario_(scenario),
       options_(options),
       events_(events),
-      core_(scenario, calibrator, options.fusion_weight),
+      core_(scenario, calibrator),
       periods_(static_cast<std::uint64_t>(std::ceil(scenario.duration_s / scenario.ccu_period_s - 1e-9))),
       channels_(make_channels(scenario)),
       participant_(named(options.participant)),

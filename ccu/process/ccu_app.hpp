@@ -42,7 +42,6 @@ struct CcuOptions {
   std::chrono::milliseconds discovery_timeout{20000};
   std::chrono::milliseconds peer_timeout{10000};  // lockstep: longest wait for a block
   std::string out_dir;                            // per-corner CSVs and ccu.stats; "" for none
-  double fusion_weight = 0.5;                     // load-cell share of the fused estimate
   bool friction_feedback = true;                  // let corners use compensated feedback
   // Process faults of the schedule are carried out (the launcher runs the process): the CCU
   // freezes itself (SIGSTOP) at its scheduled kill time for the launcher to SIGKILL it, and in

@@ -28,9 +28,8 @@ faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, fau
 }
 
 CcuCore::CcuCore(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator,
-                 double fusion_weight, const faults::MonitorParams& monitor)
-    : scenario_(scenario), planner_(scenario), fusion_weight_(fusion_weight) {
-  if (!(fusion_weight >= 0.0 && fusion_weight <= 1.0)) throw std::invalid_argument("fusion weight must be in [0, 1]");
+                 const faults::MonitorParams& monitor)
+    : scenario_(scenario), planner_(scenario) {
   const faults::MonitorParams mp = monitor_params_for(scenario, monitor);
   for (std::size_t i = 0; i < scenario.corners.size(); ++i) {
     const auto slot = slot_of(scenario.corners[i].name);

@@ -46,7 +46,7 @@ class CcuCore {
  public:
   // Throws std::invalid_argument (corner names not FL/FR/RL/RR, twice, bad configs).
   CcuCore(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator,
-          double fusion_weight, const faults::MonitorParams& monitor = {});
+          const faults::MonitorParams& monitor = {});
 
   bool has(std::size_t slot) const { return supervisors_[slot] != nullptr; }
   // The scenario index of the corner in `slot`.
@@ -63,12 +63,10 @@ class CcuCore {
   double demand_total_kN(double time_s) const;
 
   const faults::CornerSupervisor& supervisor(std::size_t slot) const { return *supervisors_[slot]; }
-  double fusion_weight() const { return fusion_weight_; }
 
  private:
   const scenario::Scenario& scenario_;
   CommandPlanner planner_;
-  double fusion_weight_;
   std::array<std::unique_ptr<faults::CornerSupervisor>, kSlots> supervisors_;
   std::array<std::size_t, kSlots> scenario_index_{};
   std::optional<faults::Redistributor> redistributor_;

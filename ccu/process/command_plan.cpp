@@ -31,9 +31,4 @@ PlannedCommand CommandPlanner::at(std::size_t i, double time_s) const {
   return p;
 }
 
-double fuse(const calibration::Estimate& e, double load_cell_kN, double weight) {
-  if (!e.valid || !e.calibrated) return load_cell_kN;
-  return weight * e.force_kN + (1.0 - weight) * e.curve_force_kN;
-}
-
 }  // namespace bbw::ccu

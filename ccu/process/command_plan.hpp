@@ -34,8 +34,4 @@ class CommandPlanner {
   std::optional<scenario::BreakpointProfile> demand_;
 };
 
-// The CCU's clamp-force estimate: before the first accepted fit, the raw load cell; after it,
-// weight * (load cell minus friction) + (1 - weight) * curve(position).
-double fuse(const calibration::Estimate& e, double load_cell_kN, double weight);
-
 }  // namespace bbw::ccu

@@ -2,7 +2,7 @@
 // estimates, per-corner commands and calibration states, per-sample logs.
 //
 //   bbw_ccu --scenario FILE [--domain N] [--mode lockstep|realtime] [--out DIR]
-//           [--calibrator FILE.yaml] [--fusion-weight W] [--friction-feedback on|off]
+//           [--calibrator FILE.yaml] [--friction-feedback on|off]
 //           [--discovery-timeout S] [--peer-timeout S]
 //           [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--process-faults]
 //           [--secure KEYS_DIR]
@@ -35,7 +35,7 @@ namespace {
 
 const char* kUsage =
     "usage: bbw_ccu --scenario FILE [--domain N] [--mode lockstep|realtime] [--out DIR]\n"
-    "               [--calibrator FILE.yaml] [--fusion-weight W] [--friction-feedback on|off]\n"
+    "               [--calibrator FILE.yaml] [--friction-feedback on|off]\n"
     "               [--discovery-timeout S] [--peer-timeout S]\n"
     "               [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--process-faults]\n"
     "               [--secure KEYS_DIR]\n";
@@ -71,14 +71,7 @@ int main(int argc, char** argv) {
       else if (k == "--mode") mode = next();
       else if (k == "--out") opt.out_dir = next();
       else if (k == "--calibrator") calibrator_file = next();
-      else if (k == "--fusion-weight") {
-        const std::string v = next();
-        char* end = nullptr;
-        opt.fusion_weight = std::strtod(v.c_str(), &end);
-        if (v.empty() || *end != '\0' || !(opt.fusion_weight >= 0.0 && opt.fusion_weight <= 1.0)) {
-          throw std::invalid_argument("--fusion-weight must be in [0, 1], got '" + v + "'");
-        }
-      } else if (k == "--friction-feedback") {
+      else if (k == "--friction-feedback") {
         const std::string v = next();
         if (v != "on" && v != "off") throw std::invalid_argument("--friction-feedback must be on or off, got '" + v + "'");
         opt.friction_feedback = v == "on";

@@ -18,7 +18,7 @@ using namespace bbw;
 TEST(CcuCoreAllocation, NoHeapAllocationPerSampleOrPeriod) {
   auto fs = faults::load_fault_scenario(faults::test::source_path("config/scenarios/faults/load_cell_bias.yaml"));
   const auto options = faults::test::default_options();
-  ccu::CcuCore core(fs.scenario, options.calibrator, 0.5);
+  ccu::CcuCore core(fs.scenario, options.calibrator);
   std::array<std::unique_ptr<scenario::CornerSim>, 4> sims;
   std::array<std::unique_ptr<faults::FaultInjector>, 4> injectors;
   for (std::size_t i = 0; i < 4; ++i) {
