@@ -58,6 +58,11 @@ TEST(SampleGuard, ClassifiesAndCountsEveryKindOfCorruptSample) {
   EXPECT_EQ(g.load_cell_missing(), 1u);
   EXPECT_EQ(g.rejected(), 7u);
   EXPECT_EQ(g.count(SampleIssue::NonFinite), 2u);
+  // A forged sample far ahead (sequence or time) is rejected, and the honest stream goes on.
+  EXPECT_EQ(g.check(at(2000000, 0.005)).issue, SampleIssue::Jump);
+  EXPECT_EQ(g.check(at(3, 1000.0)).issue, SampleIssue::Jump);
+  EXPECT_TRUE(g.check(at(3, 0.0025)).usable());
+  EXPECT_EQ(g.count(SampleIssue::Jump), 2u);
   // A restarted corner counts from 1 again; its time must still move forward.
   g.rejoin();
   EXPECT_EQ(g.check(at(1, 0.001)).issue, SampleIssue::TimeBackwards);

@@ -24,6 +24,9 @@ void GuardLimits::validate() const {
           load_cell_max_kN, "must be finite and > load_cell_min_kN");
   require(std::isfinite(current_abs_max_A) && current_abs_max_A > 0.0, "current_abs_max_A", current_abs_max_A,
           "must be > 0");
+  require(std::isfinite(max_sequence_jump) && max_sequence_jump >= 1.0, "max_sequence_jump", max_sequence_jump,
+          "must be >= 1");
+  require(std::isfinite(max_time_jump_s) && max_time_jump_s > 0.0, "max_time_jump_s", max_time_jump_s, "must be > 0");
 }
 
 const char* to_string(SampleIssue i) {
@@ -34,6 +37,7 @@ const char* to_string(SampleIssue i) {
     case SampleIssue::Duplicate: return "duplicate";
     case SampleIssue::SequenceBackwards: return "sequence_backwards";
     case SampleIssue::TimeBackwards: return "time_backwards";
+    case SampleIssue::Jump: return "jump";
   }
   return "?";
 }
@@ -66,6 +70,10 @@ SampleCheck SampleGuard::check(const CornerReading& r) {
     c.issue = SampleIssue::SequenceBackwards;
   } else if (have_last_ && !(r.time_s > last_time_s_)) {
     c.issue = SampleIssue::TimeBackwards;
+  } else if (have_last_ && seq_continuity_ &&
+             (static_cast<double>(r.seq - last_seq_) > limits_.max_sequence_jump ||
+              r.time_s - last_time_s_ > limits_.max_time_jump_s)) {
+    c.issue = SampleIssue::Jump;
   }
   ++counts_[static_cast<std::size_t>(c.issue)];
   if (!c.usable()) {

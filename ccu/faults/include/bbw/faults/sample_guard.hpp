@@ -18,6 +18,11 @@ struct GuardLimits {
   double load_cell_min_kN = -5.0;
   double load_cell_max_kN = 80.0;
   double current_abs_max_A = 80.0;
+  // Within one incarnation (between rejoins) a corner's sequence and time move forward by what
+  // its rate allows; a forged sample far ahead would otherwise make every later honest sample
+  // look like it went backwards.
+  double max_sequence_jump = 20000.0;  // samples (20 s at 1 kHz)
+  double max_time_jump_s = 20.0;
 
   void validate() const;  // throws std::invalid_argument naming the field
 };
@@ -29,8 +34,9 @@ enum class SampleIssue : std::uint8_t {
   Duplicate,          // the same sequence number again
   SequenceBackwards,  // a sequence number below the last one accepted
   TimeBackwards,      // time not after the last accepted sample's
+  Jump,               // sequence or time far ahead of the last accepted sample's
 };
-inline constexpr std::size_t kSampleIssueCount = 6;
+inline constexpr std::size_t kSampleIssueCount = 7;
 const char* to_string(SampleIssue i);
 
 struct SampleCheck {
