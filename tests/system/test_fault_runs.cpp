@@ -15,43 +15,26 @@
 
 #include "bbw/common/csv.hpp"
 #include "bbw/launch/child.hpp"
+#include "system_test_support.hpp"
 #include "bbw/launch/stats_file.hpp"
 
 namespace {
 
 using namespace std::chrono_literals;
+using namespace bbw::system_test;
 namespace fs = std::filesystem;
 
-std::string src(const std::string& rel) { return std::string(BBW_TEST_SOURCE_DIR) + "/" + rel; }
-std::string bin(const std::string& name) { return std::string(BBW_TEST_BINARY_DIR) + "/bin/" + name; }
 
-std::string slurp(const std::string& file) {
-  std::ifstream f(file);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
-std::string scratch(const std::string& test) {
-  const fs::path p = fs::temp_directory_path() / ("bbw_faults_" + test + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p.string();
-}
+std::string scratch(const std::string& test) { return bbw::system_test::scratch("faults", test); }
 
-struct LaunchRun {
-  bbw::launch::ExitStatus status;
-  std::string out, err, dir;
-};
+using LaunchRun = bbw::system_test::ProcessRun;
 
 LaunchRun launch(const std::string& scenario, const std::string& dir, int domain, const std::string& mode) {
-  bbw::launch::Child child("bbw_launch",
-                           {bin("bbw_launch"), src(scenario), "--out", dir + "/out", "--mode", mode, "--domain",
-                            std::to_string(domain), "--discovery-timeout", "20", "--no-report"},
-                           dir + "/launch.stdout", dir + "/launch.stderr");
-  auto status = child.wait_until(std::chrono::steady_clock::now() + 170s);
-  if (!status) status = child.stop(2000ms);
-  return {*status, slurp(dir + "/launch.stdout"), slurp(dir + "/launch.stderr"), dir};
+  return run("bbw_launch",
+             {bin("bbw_launch"), src(scenario), "--out", dir + "/out", "--mode", mode, "--domain",
+              std::to_string(domain), "--discovery-timeout", "20", "--no-report"},
+             dir, 170s);
 }
 
 // A flat reading of summary.json's "faults" and "detections" arrays: one map per object, string

@@ -19,48 +19,31 @@
 #include <vector>
 
 #include "bbw/launch/child.hpp"
+#include "system_test_support.hpp"
 #include "bbw/launch/stats_file.hpp"
 
 namespace {
 
 using namespace std::chrono_literals;
+using bbw::system_test::bin;
+using bbw::system_test::ProcessRun;
+using bbw::system_test::slurp;
+using bbw::system_test::src;
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-std::string src(const std::string& rel) { return std::string(BBW_TEST_SOURCE_DIR) + "/" + rel; }
-std::string bin(const std::string& name) { return std::string(BBW_TEST_BINARY_DIR) + "/bin/" + name; }
 
 const char* kCorners[] = {"FL", "FR", "RL", "RR"};
 constexpr double kIntruderForce = 77.7;  // kN: no scenario commands it, so it is easy to spot
 
-std::string slurp(const std::string& file) {
-  std::ifstream f(file);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
-std::string scratch(const std::string& test) {
-  const fs::path p = fs::temp_directory_path() / ("bbw_secure_" + test + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p.string();
-}
-
-struct ProcessRun {
-  bbw::launch::ExitStatus status;
-  std::string out, err;
-};
+std::string scratch(const std::string& test) { return bbw::system_test::scratch("secure", test); }
 
 // BBW_DDS_LOG=warning: a failed handshake or discovery leaves Fast DDS's warnings in the
 // children's .err files (nothing is printed when all goes well).
 ProcessRun run(const std::string& name, const std::vector<std::string>& argv, const std::string& dir,
                std::chrono::seconds limit) {
-  bbw::launch::Child child(name, argv, dir + "/" + name + ".stdout", dir + "/" + name + ".stderr",
-                           {"BBW_DDS_LOG=warning"});
-  auto status = child.wait_until(Clock::now() + limit);
-  if (!status) status = child.stop(2000ms);
-  return {*status, slurp(dir + "/" + name + ".stdout"), slurp(dir + "/" + name + ".stderr")};
+  return bbw::system_test::run(name, argv, dir, limit, {"BBW_DDS_LOG=warning"});
 }
 
 std::vector<std::string> launch_argv(const std::string& dir, int domain, const std::string& mode, bool secure) {

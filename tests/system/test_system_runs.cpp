@@ -19,43 +19,17 @@
 #include "bbw/common/csv.hpp"
 #include "bbw/launch/child.hpp"
 #include "bbw/launch/stats_file.hpp"
+#include "system_test_support.hpp"
 
 namespace {
 
 using namespace std::chrono_literals;
+using namespace bbw::system_test;
 namespace fs = std::filesystem;
 
-// The source and build trees this test was compiled for (tests/system/CMakeLists.txt).
-std::string src(const std::string& rel) { return std::string(BBW_TEST_SOURCE_DIR) + "/" + rel; }
-std::string bin(const std::string& name) { return std::string(BBW_TEST_BINARY_DIR) + "/bin/" + name; }
 
-std::string slurp(const std::string& file) {
-  std::ifstream f(file);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
-struct ProcessRun {
-  bbw::launch::ExitStatus status;
-  std::string out, err, dir;
-};
-
-// Runs a command to completion (bounded by `limit`), capturing its output.
-ProcessRun run(const std::string& name, const std::vector<std::string>& argv, const std::string& dir,
-        std::chrono::seconds limit = 120s, const std::vector<std::string>& env = {}) {
-  fs::create_directories(dir);
-  bbw::launch::Child child(name, argv, dir + "/" + name + ".stdout", dir + "/" + name + ".stderr", env);
-  auto status = child.wait_until(std::chrono::steady_clock::now() + limit);
-  if (!status) status = child.stop(2000ms);
-  return {*status, slurp(dir + "/" + name + ".stdout"), slurp(dir + "/" + name + ".stderr"), dir};
-}
-
-std::string scratch(const std::string& test) {
-  const fs::path p = fs::temp_directory_path() / ("bbw_system_" + test + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  return p.string();
-}
+std::string scratch(const std::string& test) { return bbw::system_test::scratch("system", test); }
 
 ProcessRun launch(const std::string& scenario, const std::string& dir, int domain, const std::string& mode,
            const std::vector<std::string>& env = {}) {
