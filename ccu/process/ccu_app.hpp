@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bbw/calibration/calibrator.hpp"
+#include "bbw/dds/process_cli.hpp"
 #include "bbw/dds/corner.hpp"
 #include "bbw/dds/events.hpp"
 #include "bbw/dds/participant.hpp"
@@ -26,15 +27,14 @@
 
 namespace bbw::ccu {
 
-enum class ClockMode { Lockstep, Realtime };
+using dds::ClockMode;
 
-enum ExitCode : int {
-  kExitOk = 0,
-  kExitRuntime = 1,
-  kExitUsage = 2,
-  kExitDiscovery = 3,
-  kExitPeerLost = 4,
-};
+using dds::ExitCode;
+using dds::kExitDiscovery;
+using dds::kExitOk;
+using dds::kExitPeerLost;
+using dds::kExitRuntime;
+using dds::kExitUsage;
 
 struct CcuOptions {
   ClockMode mode = ClockMode::Lockstep;

@@ -1,11 +1,12 @@
 // bbw_ccu: the central control unit over Fast DDS: one calibrator per corner, fused clamp-force
 // estimates, per-corner commands and calibration states, per-sample logs.
 //
-//   bbw_ccu --scenario FILE [--domain N] [--mode lockstep|realtime] [--out DIR]
-//           [--calibrator FILE.yaml] [--friction-feedback on|off]
-//           [--discovery-timeout S] [--peer-timeout S]
-//           [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--process-faults]
-//           [--secure KEYS_DIR]
+//   bbw_ccu --scenario FILE [--domain N] [--mode lockstep|realtime]
+//           [--discovery-timeout S] [--peer-timeout S] [--process-faults]
+//           [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--secure KEYS_DIR]
+//           [--out DIR] [--calibrator FILE.yaml] [--friction-feedback on|off]
+//
+// The flags in the first three lines are bbw_corner's too (bbw/dds/process_cli.hpp).
 //
 // --secure: DDS Security with the CCU's identity from KEYS_DIR (`./bbw keys KEYS_DIR`,
 // docs/security.md); a missing key file is a configuration error (exit 2).
@@ -24,7 +25,7 @@
 #include <string>
 
 #include "bbw/calibration/config_yaml.hpp"
-#include "bbw/dds/domain.hpp"
+#include "bbw/dds/process_cli.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/launch/signals.hpp"
 #include "bbw/scenario/load.hpp"
@@ -33,20 +34,8 @@
 
 namespace {
 
-const char* kUsage =
-    "usage: bbw_ccu --scenario FILE [--domain N] [--mode lockstep|realtime] [--out DIR]\n"
-    "               [--calibrator FILE.yaml] [--friction-feedback on|off]\n"
-    "               [--discovery-timeout S] [--peer-timeout S]\n"
-    "               [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--process-faults]\n"
-    "               [--secure KEYS_DIR]\n";
-
-std::chrono::milliseconds seconds_arg(const std::string& key, const std::string& v) {
-  char* end = nullptr;
-  const double s = std::strtod(v.c_str(), &end);
-  if (v.empty() || *end != '\0' || !(s > 0.0) || s > 3600.0) {
-    throw std::invalid_argument(key + " must be a number of seconds in (0, 3600], got '" + v + "'");
-  }
-  return std::chrono::milliseconds(static_cast<long long>(s * 1000.0));
+std::string usage() {
+  return bbw::dds::process_usage("bbw_ccu", "", {"[--out DIR] [--calibrator FILE.yaml] [--friction-feedback on|off]"});
 }
 
 }  // namespace
@@ -57,43 +46,34 @@ int main(int argc, char** argv) {
   bbw::launch::SignalWatcher signals([&](int) { events.interrupt(); });
 
   CcuOptions opt;
-  std::string scenario_file, mode = "lockstep", calibrator_file = BBW_DEFAULT_CALIBRATOR_CONFIG, secure_dir;
-  std::optional<std::string> domain_arg;
+  bbw::dds::ProcessFlags flags;
+  std::string calibrator_file = BBW_DEFAULT_CALIBRATOR_CONFIG;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string k = argv[i];
-      auto next = [&]() -> std::string {
-        if (i + 1 >= argc) throw std::invalid_argument("missing value after " + k);
-        return argv[++i];
-      };
-      if (k == "--scenario") scenario_file = next();
-      else if (k == "--domain") domain_arg = next();
-      else if (k == "--mode") mode = next();
-      else if (k == "--out") opt.out_dir = next();
-      else if (k == "--calibrator") calibrator_file = next();
+    for (bbw::dds::ArgCursor args(argc, argv); !args.done();) {
+      const std::string k = args.flag();
+      if (flags.take(k, args)) continue;
+      if (k == "--out") opt.out_dir = args.value();
+      else if (k == "--calibrator") calibrator_file = args.value();
       else if (k == "--friction-feedback") {
-        const std::string v = next();
+        const std::string v = args.value();
         if (v != "on" && v != "off") throw std::invalid_argument("--friction-feedback must be on or off, got '" + v + "'");
         opt.friction_feedback = v == "on";
       }
-      else if (k == "--discovery-timeout") opt.discovery_timeout = seconds_arg(k, next());
-      else if (k == "--peer-timeout") opt.peer_timeout = seconds_arg(k, next());
-      else if (k == "--dds-profiles") opt.participant.profiles_file = next();
-      else if (k == "--dds-participant-profile") opt.participant.profile = next();
-      else if (k == "--process-faults") opt.process_faults = true;
-      else if (k == "--secure") secure_dir = next();
-      else if (k == "-h" || k == "--help") { std::cout << kUsage; return 0; }
+      else if (k == "-h" || k == "--help") { std::cout << usage(); return 0; }
       else throw std::invalid_argument("unknown argument '" + k + "'");
     }
-    if (scenario_file.empty()) throw std::invalid_argument("--scenario is required");
-    if (mode == "lockstep") opt.mode = ClockMode::Lockstep;
-    else if (mode == "realtime") opt.mode = ClockMode::Realtime;
-    else throw std::invalid_argument("--mode must be lockstep or realtime, got '" + mode + "'");
-    opt.participant.domain_id = bbw::dds::resolve_domain_id(domain_arg, std::getenv("BBW_DOMAIN"));
+    flags.finish(std::getenv("BBW_DOMAIN"));
   } catch (const std::exception& e) {
-    std::cerr << "bbw_ccu: " << e.what() << "\n" << kUsage;
+    std::cerr << "bbw_ccu: " << e.what() << "\n" << usage();
     return kExitUsage;
   }
+  opt.mode = flags.mode;
+  opt.participant = flags.participant;
+  opt.discovery_timeout = flags.discovery_timeout;
+  opt.peer_timeout = flags.peer_timeout;
+  opt.process_faults = flags.process_faults;
+  const std::string& secure_dir = flags.secure_dir;
+  const std::string& scenario_file = flags.scenario_file;
 
   // Config is loaded and validated before any DDS entity exists.
   std::optional<bbw::scenario::Scenario> scenario;
@@ -124,7 +104,7 @@ int main(int argc, char** argv) {
   std::string error;
   try {
     CcuApp app(*scenario, *calibrator, opt, events);
-    std::cout << "bbw_ccu: domain " << opt.participant.domain_id << ", mode " << mode << ", scenario "
+    std::cout << "bbw_ccu: domain " << opt.participant.domain_id << ", mode " << flags.mode_name << ", scenario "
               << scenario->name << ", " << scenario->corners.size() << " corners" << std::endl;
     rc = app.run(error);
     if (!opt.out_dir.empty()) app.write_stats(opt.out_dir + "/ccu.stats");

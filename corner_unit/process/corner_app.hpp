@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bbw/dds/process_cli.hpp"
 #include "bbw/dds/convert.hpp"
 #include "bbw/dds/corner.hpp"
 #include "bbw/dds/events.hpp"
@@ -27,7 +28,7 @@
 
 namespace bbw::corner_process {
 
-enum class ClockMode { Lockstep, Realtime };
+using dds::ClockMode;
 
 struct CornerOptions {
   dds::Corner corner = dds::Corner::FL;
@@ -58,13 +59,12 @@ struct CornerOptions {
 };
 
 // Exit statuses (docs/distributed.md).
-enum ExitCode : int {
-  kExitOk = 0,
-  kExitRuntime = 1,
-  kExitUsage = 2,
-  kExitDiscovery = 3,
-  kExitPeerLost = 4,
-};
+using dds::ExitCode;
+using dds::kExitDiscovery;
+using dds::kExitOk;
+using dds::kExitPeerLost;
+using dds::kExitRuntime;
+using dds::kExitUsage;
 
 struct CornerStats {
   std::uint64_t periods = 0;

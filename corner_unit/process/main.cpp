@@ -1,10 +1,11 @@
 // bbw_corner: one e-caliper process (plant, sensors, local controller) over Fast DDS.
 //
 //   bbw_corner --corner FL|FR|RL|RR --scenario FILE [--domain N] [--mode lockstep|realtime]
-//              [--stats FILE] [--discovery-timeout S] [--peer-timeout S]
-//              [--dds-profiles FILE.xml] [--dds-participant-profile NAME]
-//              [--periods-log FILE] [--process-faults] [--incarnation N --resume-at S]
-//              [--secure KEYS_DIR]
+//              [--discovery-timeout S] [--peer-timeout S] [--process-faults]
+//              [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--secure KEYS_DIR]
+//              [--stats FILE] [--periods-log FILE] [--incarnation N --resume-at S]
+//
+// The flags from --scenario to --secure are bbw_ccu's too (bbw/dds/process_cli.hpp).
 //
 // --secure: DDS Security with this corner's identity from KEYS_DIR (`./bbw keys KEYS_DIR`,
 // docs/security.md); a missing key file is a configuration error (exit 2).
@@ -27,7 +28,7 @@
 #include <string>
 
 #include "bbw/common/strict_yaml.hpp"
-#include "bbw/dds/domain.hpp"
+#include "bbw/dds/process_cli.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/launch/signals.hpp"
 #include "bbw/launch/stats_file.hpp"
@@ -37,20 +38,9 @@
 
 namespace {
 
-const char* kUsage =
-    "usage: bbw_corner --corner FL|FR|RL|RR --scenario FILE [--domain N] [--mode lockstep|realtime]\n"
-    "                  [--stats FILE] [--discovery-timeout S] [--peer-timeout S]\n"
-    "                  [--dds-profiles FILE.xml] [--dds-participant-profile NAME]\n"
-    "                  [--periods-log FILE] [--process-faults] [--incarnation N --resume-at S]\n"
-    "                  [--secure KEYS_DIR]\n";
-
-std::chrono::milliseconds seconds_arg(const std::string& key, const std::string& v) {
-  char* end = nullptr;
-  const double s = std::strtod(v.c_str(), &end);
-  if (v.empty() || *end != '\0' || !(s > 0.0) || s > 3600.0) {
-    throw std::invalid_argument(key + " must be a number of seconds in (0, 3600], got '" + v + "'");
-  }
-  return std::chrono::milliseconds(static_cast<long long>(s * 1000.0));
+std::string usage() {
+  return bbw::dds::process_usage("bbw_corner", "--corner FL|FR|RL|RR",
+                                {"[--stats FILE] [--periods-log FILE] [--incarnation N --resume-at S]"});
 }
 
 }  // namespace
@@ -61,55 +51,46 @@ int main(int argc, char** argv) {
   bbw::launch::SignalWatcher signals([&](int) { events.interrupt(); });
 
   CornerOptions opt;
-  std::string corner_arg, scenario_file, mode = "lockstep", secure_dir;
-  std::optional<std::string> domain_arg;
+  bbw::dds::ProcessFlags flags;
+  std::string corner_arg;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string k = argv[i];
-      auto next = [&]() -> std::string {
-        if (i + 1 >= argc) throw std::invalid_argument("missing value after " + k);
-        return argv[++i];
-      };
-      if (k == "--corner") corner_arg = next();
-      else if (k == "--scenario") scenario_file = next();
-      else if (k == "--domain") domain_arg = next();
-      else if (k == "--mode") mode = next();
-      else if (k == "--stats") opt.stats_file = next();
-      else if (k == "--discovery-timeout") opt.discovery_timeout = seconds_arg(k, next());
-      else if (k == "--peer-timeout") opt.peer_timeout = seconds_arg(k, next());
-      else if (k == "--dds-profiles") opt.participant.profiles_file = next();
-      else if (k == "--dds-participant-profile") opt.participant.profile = next();
-      else if (k == "--periods-log") opt.periods_log = next();
-      else if (k == "--secure") secure_dir = next();
-      else if (k == "--process-faults") opt.process_faults = true;
+    for (bbw::dds::ArgCursor args(argc, argv); !args.done();) {
+      const std::string k = args.flag();
+      if (flags.take(k, args)) continue;
+      if (k == "--corner") corner_arg = args.value();
+      else if (k == "--stats") opt.stats_file = args.value();
+      else if (k == "--periods-log") opt.periods_log = args.value();
       else if (k == "--incarnation") {
-        const std::string v = next();
+        const std::string v = args.value();
         char* end = nullptr;
         const unsigned long n = std::strtoul(v.c_str(), &end, 10);
         if (v.empty() || *end != '\0' || n > 1000) throw std::invalid_argument("--incarnation must be 0..1000, got '" + v + "'");
         opt.incarnation = static_cast<std::uint32_t>(n);
       } else if (k == "--resume-at") {
-        const std::string v = next();
+        const std::string v = args.value();
         char* end = nullptr;
         opt.resume_at_s = std::strtod(v.c_str(), &end);
         if (v.empty() || *end != '\0' || !(opt.resume_at_s >= 0.0)) throw std::invalid_argument("--resume-at must be seconds >= 0, got '" + v + "'");
       }
-      else if (k == "-h" || k == "--help") { std::cout << kUsage; return 0; }
+      else if (k == "-h" || k == "--help") { std::cout << usage(); return 0; }
       else throw std::invalid_argument("unknown argument '" + k + "'");
     }
     if (corner_arg.empty()) throw std::invalid_argument("--corner is required");
-    if (scenario_file.empty()) throw std::invalid_argument("--scenario is required");
+    flags.finish(std::getenv("BBW_DOMAIN"));
     const auto corner = bbw::dds::parse_corner(corner_arg);
     if (!corner) throw std::invalid_argument("unknown corner '" + corner_arg + "' (expected FL, FR, RL or RR)");
     opt.corner = *corner;
-    if (mode == "lockstep") opt.mode = ClockMode::Lockstep;
-    else if (mode == "realtime") opt.mode = ClockMode::Realtime;
-    else throw std::invalid_argument("--mode must be lockstep or realtime, got '" + mode + "'");
-    opt.participant.domain_id = bbw::dds::resolve_domain_id(domain_arg, std::getenv("BBW_DOMAIN"));
   } catch (const std::exception& e) {
-    std::cerr << "bbw_corner: " << e.what() << "\n" << kUsage;
+    std::cerr << "bbw_corner: " << e.what() << "\n" << usage();
     return kExitUsage;
   }
+  opt.mode = flags.mode;
+  opt.participant = flags.participant;
+  opt.discovery_timeout = flags.discovery_timeout;
+  opt.peer_timeout = flags.peer_timeout;
+  opt.process_faults = flags.process_faults;
+  const std::string& secure_dir = flags.secure_dir;
+  const std::string& scenario_file = flags.scenario_file;
 
   // Config is loaded and validated before any DDS entity exists.
   std::optional<bbw::scenario::Scenario> scenario;
@@ -154,7 +135,7 @@ int main(int argc, char** argv) {
       app.reset();  // the old participant goes before the new one exists
       app = std::make_unique<CornerApp>(*scenario, o, events);
       if (attempt == 1) {
-        std::cout << "bbw_corner " << corner_arg << ": domain " << opt.participant.domain_id << ", mode " << mode
+        std::cout << "bbw_corner " << corner_arg << ": domain " << opt.participant.domain_id << ", mode " << flags.mode_name
                   << ", scenario " << scenario->name << std::endl;
       }
       rc = app->run(error);

@@ -30,10 +30,6 @@ std::size_t LoopResult::faults_raised() const {
   return n;
 }
 
-namespace {
-
-constexpr std::array<Target, kCorners> kTargets = {Target::FL, Target::FR, Target::RL, Target::RR};
-
 CornerReading reading_from(const scenario::CornerSample& s, std::uint64_t seq_offset) {
   CornerReading r;
   r.seq = s.seq - seq_offset;
@@ -46,6 +42,10 @@ CornerReading reading_from(const scenario::CornerSample& s, std::uint64_t seq_of
       s.command_kind == scenario::CommandKind::Force ? s.command : std::numeric_limits<double>::quiet_NaN();
   return r;
 }
+
+namespace {
+
+constexpr std::array<Target, kCorners> kTargets = {Target::FL, Target::FR, Target::RL, Target::RR};
 
 struct Corner {
   std::size_t scenario_index = 0;

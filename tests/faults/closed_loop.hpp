@@ -16,10 +16,15 @@
 #include "bbw/faults/reading.hpp"
 #include "bbw/faults/redistributor.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
+#include "bbw/scenario/corner_sim.hpp"
 
 namespace bbw::faults::test {
 
 std::string source_path(const std::string& rel);
+
+// What a corner's sample tells the CCU (the force command only when it is a force command);
+// seq_offset renumbers a restarted corner's samples.
+CornerReading reading_from(const scenario::CornerSample& s, std::uint64_t seq_offset = 0);
 
 struct LoopOptions {
   calibration::CalibratorConfig calibrator;

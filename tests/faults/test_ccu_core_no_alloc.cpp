@@ -40,14 +40,7 @@ TEST(CcuCoreAllocation, NoHeapAllocationPerSampleOrPeriod) {
       for (int s = 0; s < 5; ++s) {
         injectors[i]->prepare(ext, sims[i]->time_s() + dt);
         const auto& smp = sims[i]->step(dt, ext);
-        faults::CornerReading r;
-        r.seq = smp.seq;
-        r.time_s = smp.time_s;
-        r.position_rev = smp.position_rev;
-        r.speed_rev_per_s = smp.speed_rev_s;
-        r.load_cell_kN = smp.force_internal_kN;
-        r.motor_current_A = smp.motor_current_A;
-        r.force_command_kN = smp.command;
+        const faults::CornerReading r = faults::test::reading_from(smp);
         const ccu::SampleOutcome& o = core.on_sample(i, r, t0 + fs.scenario.ccu_period_s);
         if (o.valid) fused_sum += o.fused_kN;
       }

@@ -37,14 +37,7 @@ TEST(FaultAllocation, NoHeapAllocationPerSample) {
     ext.feedback = sup.view().feedback;
     injector.prepare(ext, t);
     const auto& s = sim.step(0.001, ext);
-    CornerReading r;
-    r.seq = s.seq;
-    r.time_s = s.time_s;
-    r.position_rev = s.position_rev;
-    r.speed_rev_per_s = s.speed_rev_s;
-    r.load_cell_kN = s.force_internal_kN;
-    r.motor_current_A = s.motor_current_A;
-    r.force_command_kN = s.command;
+    const CornerReading r = test::reading_from(s);
     const CornerView& v = sup.on_sample(r, t);
     sup.tick(t);
     cap[0] = {v.available, v.force_limit_kN};

@@ -39,6 +39,7 @@
 
 #include "bbw/common/json.hpp"
 #include "bbw/dds/domain.hpp"
+#include "bbw/dds/process_cli.hpp"
 #include "bbw/dds/shm_cleanup.hpp"
 #include "bbw/faults/link_faults.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
@@ -98,22 +99,14 @@ int main(int argc, char** argv) {
   std::string keys_dir = std::string(BBW_REPO_DIR) + "/keys";
   int domain = 0;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string k = argv[i];
-      auto next = [&]() -> std::string {
-        if (i + 1 >= argc) throw std::invalid_argument("missing value after " + k);
-        return argv[++i];
-      };
+    for (bbw::dds::ArgCursor args(argc, argv); !args.done();) {
+      const std::string k = args.flag();
+      auto next = [&] { return args.value(); };
       if (k == "--out") out_dir = next();
-      else if (k == "--mode") mode = next();
+      else if (k == "--mode") bbw::dds::parse_clock_mode(mode = next());
       else if (k == "--domain") domain_arg = next();
       else if (k == "--discovery-timeout") {
-        const std::string v = next();
-        char* end = nullptr;
-        discovery_s = std::strtod(v.c_str(), &end);
-        if (v.empty() || *end != '\0' || !(discovery_s > 0.0 && discovery_s <= 600.0)) {
-          throw std::invalid_argument("--discovery-timeout must be seconds in (0, 600], got '" + v + "'");
-        }
+        discovery_s = static_cast<double>(bbw::dds::seconds_arg(k, next(), 600.0).count()) / 1000.0;
       } else if (k == "--friction-feedback") feedback = next();
       else if (k == "--no-report") report = false;
       else if (k == "--secure") secure = true;
@@ -125,7 +118,6 @@ int main(int argc, char** argv) {
     }
     if (scenario_file.empty()) throw std::invalid_argument("a scenario file is required");
     if (out_dir.empty()) throw std::invalid_argument("--out DIR is required");
-    if (mode != "lockstep" && mode != "realtime") throw std::invalid_argument("--mode must be lockstep or realtime, got '" + mode + "'");
     if (feedback != "on" && feedback != "off") throw std::invalid_argument("--friction-feedback must be on or off");
     domain = bbw::dds::resolve_domain_id(domain_arg, std::getenv("BBW_DOMAIN"));
   } catch (const std::exception& e) {
