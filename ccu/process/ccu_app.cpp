@@ -249,6 +249,7 @@ void CcuApp::process_block(CornerChannel& channel_of_partition, const msg::Measu
     ch->next_block = b.block_seq();
     ch->next_sample_seq = b.samples().empty() ? 1 : b.samples().front().seq();
     ++ch->rejoins;
+    core_.on_link_event(ch->slot, faults::LinkEvent::Restarted, arrival_s);
   }
   if (b.block_seq() != ch->next_block) ++ch->block_gaps;
   // Never backwards within an incarnation: an old or forged block number cannot make the
@@ -332,7 +333,10 @@ void CcuApp::drain_qos_events(double now_s, bool lockstep) {
   for (std::size_t i = 0; i < channels_.size(); ++i) {
     CornerChannel& ch = channels_[i];
     while (blocks_[i]->take_event(e)) {
-      if (!ch.have_handles) continue;
+      // A corner that has sent its last block is done: its deadline passing and its writer
+      // leaving are its normal end (they raised link_lost and process_lost on the corners that
+      // finished first while the CCU still waited for another's last block).
+      if (!ch.have_handles || ch.finished) continue;
       const double t = lockstep ? now_s : std::chrono::duration<double>(e.at - t0_).count();
       if (e.kind == dds::QosEvent::Kind::DeadlineMissed && e.handle == ch.instance) {
         ++ch.deadlines_missed;

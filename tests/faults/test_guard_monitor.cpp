@@ -198,6 +198,36 @@ TEST(FaultMonitor, DeadlineLivelinessAndRejoin) {
   EXPECT_FALSE(m.take_rejoin());
 }
 
+// A restarted process (new incarnation) that rejoins before the participant lease ran out: the
+// open link outage is renamed the process's death, from the link's onset; a process already
+// named is left as it was.
+TEST(FaultMonitor, ARestartedProcessNamesTheOutageAsTheProcesssDeath) {
+  MonitorParams p;
+  FaultMonitor m(p, Target::RR);
+  SampleCheck ok;
+  m.update(at(1, 0.001), ok, nullptr, 5.0, 0.001);
+  m.tick(0.001 + p.deadline_s * 1.1);
+  ASSERT_EQ(m.diagnosis(Part::Network).finding, Finding::LinkLost);
+  m.on_link_event(LinkEvent::Restarted, 0.5);
+  EXPECT_TRUE(m.ok(Part::Network));
+  EXPECT_EQ(m.diagnosis(Part::Process).finding, Finding::ProcessLost);
+  EXPECT_NEAR(m.diagnosis(Part::Process).onset_s, 0.001, 1e-12);
+  EXPECT_NEAR(m.diagnosis(Part::Process).detected_s, 0.5, 1e-12);
+  EXPECT_TRUE(m.process_was_lost());
+  m.update(at(1, 0.5), ok, nullptr, 5.0, 0.5);
+  EXPECT_TRUE(m.ok(Part::Process));
+  EXPECT_TRUE(m.take_rejoin());
+
+  // Already named by its lease: the restart changes nothing.
+  FaultMonitor n(p, Target::FL);
+  n.update(at(1, 0.001), ok, nullptr, 5.0, 0.001);
+  n.on_link_event(LinkEvent::LivelinessLost, 2.0);
+  const Diagnosis before = n.diagnosis(Part::Process);
+  n.on_link_event(LinkEvent::Restarted, 2.5);
+  EXPECT_EQ(n.diagnosis(Part::Process).detected_s, before.detected_s);
+  EXPECT_EQ(n.diagnosis(Part::Process).finding, Finding::ProcessLost);
+}
+
 TEST(FaultMonitor, TorqueBalanceSeparatesPartialAndTotalLoss) {
   MonitorParams p;
   SampleCheck ok;

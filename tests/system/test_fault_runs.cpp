@@ -207,4 +207,56 @@ TEST(SystemFaultsRealtime, KilledAndSilencedCornersDetectedWithin50ms) {
   fs::remove_all(dir);
 }
 
+// Domain 187: in real time, RR's process is killed at 1.0 s and restarted 0.5 s later. The
+// loss is detected within 50 ms (as a lost link: nothing tells a dead process from a cut link
+// that fast); the restarted process's first samples (a new incarnation) name the process, long
+// before the 2 s lease would have. Its new samples flow with no gap, none rejected, its
+// calibrator restarts once from the last good curve.
+TEST(SystemFaultsRealtime, ARestartedCornerIsNamedAsAProcessLossAndRejoins) {
+  const std::string dir = scratch("realtime_restart");
+  const LaunchRun r = launch("tests/system/data/rt_restart.yaml", dir, 187, "realtime");
+  ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
+  const std::string summary = slurp(dir + "/out/summary.json");
+  const auto faults = objects(summary, "faults");
+  ASSERT_EQ(faults.size(), 1u) << summary;
+  const auto& f = faults[0];
+  EXPECT_EQ(f.at("detected"), "true");
+  EXPECT_LT(num(f, "latency_ms"), 50.0);
+  EXPECT_EQ(f.at("diagnosis"), "process_lost");
+  EXPECT_EQ(f.at("correct"), "true");
+  EXPECT_GE(num(f, "diagnosis_s"), 1.5) << "named before the new process joined";
+  EXPECT_LT(num(f, "diagnosis_s"), 2.5) << "named by the lease, not by the restart";
+  for (const auto& d : objects(summary, "detections")) EXPECT_EQ(d.at("corner"), "RR") << d.at("finding");
+  for (const auto& corner : objects(summary, "corners")) {
+    EXPECT_EQ(num(corner, "samples_published"), num(corner, "samples_received")) << corner.at("corner");
+    EXPECT_EQ(num(corner, "sequence_gaps"), 0.0) << corner.at("corner");
+    EXPECT_EQ(num(corner, "samples_rejected_by_guard"), 0.0) << corner.at("corner");
+  }
+  const std::string ccu = dir + "/out/ccu.stats";
+  const auto st = bbw::launch::read_stats(ccu);
+  EXPECT_EQ(bbw::launch::stat_number(st, "RR.rejoins", ccu), 1.0);
+  EXPECT_EQ(bbw::launch::stat_number(st, "RR.calibrator_restarts", ccu), 1.0);
+  // The CCU's RR log: times in order, one restart of the numbering (to 1) across the dead time,
+  // and the new process's samples up to the end.
+  bbw::csv::ReadOptions o;
+  o.required = {"time_s", "seq"};
+  const auto t = bbw::csv::read(dir + "/out/ccu_RR.csv", o);
+  const auto& time = t.column("time_s");
+  const auto& seq = t.column("seq");
+  ASSERT_GT(t.rows(), 2000u);
+  int restarts = 0;
+  for (std::size_t i = 1; i < t.rows(); ++i) {
+    ASSERT_GT(time[i], time[i - 1]) << "row " << i;
+    if (seq[i] != seq[i - 1] + 1) {
+      ++restarts;
+      EXPECT_EQ(seq[i], 1.0);
+      EXPECT_NEAR(time[i - 1], 1.0, 0.0011);
+      EXPECT_GE(time[i], 1.5);
+    }
+  }
+  EXPECT_EQ(restarts, 1);
+  EXPECT_NEAR(time.back(), 3.5, 1e-6);
+  fs::remove_all(dir);
+}
+
 }  // namespace

@@ -153,6 +153,13 @@ void FaultMonitor::on_link_event(LinkEvent e, double time_s) {
       process_lost_since_rejoin_ = true;
       break;
     case LinkEvent::LivelinessRecovered: break;  // samples arriving decide the rejoin
+    case LinkEvent::Restarted:
+      // Faster than the participant lease (2 s) when the launcher restarts the process within it.
+      if (ok(Part::Process)) {
+        confirm(Finding::ProcessLost, any_arrival_ ? last_arrival_s_ : time_s, time_s);
+        process_lost_since_rejoin_ = true;
+      }
+      break;
   }
 }
 
@@ -262,6 +269,9 @@ void FaultMonitor::check_residual(const CornerReading& r, const calibration::Est
     have_reference_ = false;  // restarts where the curve is trusted again
     return;
   }
+  // A model update (an accepted fit, the first above all) moves the residual by itself: the
+  // change rule restarts from the new model's residual, unless a fault is already suspected.
+  if (e.fit_accepted && !residual_suspect_) have_reference_ = false;
   if (!have_reference_) {
     have_reference_ = true;
     reference_kN_ = residual_kN_;

@@ -98,7 +98,7 @@ enum class Finding : std::uint8_t {
   ActuatorLost,        // (almost) no torque for the current drawn
   ActuatorTracking,    // cannot follow a reachable command
   LinkLost,          // deadline missed / no samples
-  ProcessLost,       // liveliness lost
+  ProcessLost,       // liveliness lost, or a new process of the corner joined
 };
 const char* to_string(Finding f);
 Part part_of(Finding f);  // Finding::None -> Part::LoadCell (unused)
@@ -111,7 +111,9 @@ struct Diagnosis {
   double detected_s = 0.0; // when it was confirmed
 };
 
-enum class LinkEvent : std::uint8_t { DeadlineMissed, LivelinessLost, LivelinessRecovered };
+// Restarted: a new process of the corner (a higher incarnation) has sent its first samples, so
+// the one before it is gone: an outage still open is the process's death, not the link's.
+enum class LinkEvent : std::uint8_t { DeadlineMissed, LivelinessLost, LivelinessRecovered, Restarted };
 
 class FaultMonitor {
  public:
