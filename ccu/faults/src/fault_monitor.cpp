@@ -269,11 +269,14 @@ void FaultMonitor::check_residual(const CornerReading& r, const calibration::Est
     have_reference_ = false;  // restarts where the curve is trusted again
     return;
   }
-  // A model update (an accepted fit, the first above all) moves the residual by itself: the
-  // change rule restarts from the new model's residual, unless a fault is already suspected.
-  if (e.fit_accepted && !residual_suspect_) have_reference_ = false;
+  // The first accepted fit replaces the initial curve and adds the friction model, which moves
+  // the residual by itself: the change rule restarts from the calibrated residual, unless a
+  // fault is already suspected. (Later fits move it little; restarting at each of them too made
+  // a slow drift 40 ms later to find.)
+  if (e.calibrated != reference_calibrated_ && !residual_suspect_) have_reference_ = false;
   if (!have_reference_) {
     have_reference_ = true;
+    reference_calibrated_ = e.calibrated;
     reference_kN_ = residual_kN_;
     reference_time_s_ = t;
   }

@@ -169,6 +169,7 @@ class FaultMonitor {
   double residual_kN_ = std::numeric_limits<double>::quiet_NaN();
   double residual_change_kN_ = std::numeric_limits<double>::quiet_NaN();
   bool have_reference_ = false;
+  bool reference_calibrated_ = false;  // the calibrator's state when the reference was set
   double reference_kN_ = 0.0;
   double reference_time_s_ = 0.0;
   bool have_prev_residual_ = false;
