@@ -20,9 +20,13 @@ const Recording& recording() {
   return rec;
 }
 
-CalibratorConfig config(Mode mode) {
+// Arg 0: robust, 1: paper, 2: robust with the optional 5 ms force-delay term, 3: robust with the
+// optional viscous term (speed from the position slope: the recording has no speed channel).
+CalibratorConfig config(int variant) {
   auto c = load_config(std::string(BBW_SOURCE_DIR) + "/config/calibrator/robust.yaml");
-  c.mode = mode;
+  c.mode = variant == 1 ? Mode::Paper : Mode::Robust;
+  if (variant == 2) c.force_delay_s = 0.005;
+  if (variant == 3) c.viscous_friction = true;
   c.elements_M = 8;
   c.samples_L = 64;
   c.pf_points_N = 20;
@@ -33,8 +37,8 @@ CalibratorConfig config(Mode mode) {
 // recording is replayed in a loop (time shifted so it keeps increasing).
 void BM_CalibratorUpdate(benchmark::State& state) {
   const auto& rec = recording();
-  const Mode mode = state.range(0) == 0 ? Mode::Robust : Mode::Paper;
-  Calibrator cal(config(mode));
+  const int variant = static_cast<int>(state.range(0));
+  Calibrator cal(config(variant));
   std::size_t k = 0;
   double t_offset = 0.0;
   const double span = rec.time_s.back() + 0.001;
@@ -48,20 +52,20 @@ void BM_CalibratorUpdate(benchmark::State& state) {
   }
   state.counters["fits"] = static_cast<double>(cal.stats().fits_accepted + cal.stats().fits_rejected);
   state.counters["state_bytes"] = static_cast<double>(cal.state_bytes());
-  state.SetLabel(to_string(mode));
+  state.SetLabel(variant == 2 ? "robust+force_delay" : variant == 3 ? "robust+viscous" : to_string(cal.config().mode));
 }
-BENCHMARK(BM_CalibratorUpdate)->Arg(0)->Arg(1);
+BENCHMARK(BM_CalibratorUpdate)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
 
 // Cost of the one update() that ends a cycle (the fit, PF update and global refit): the
 // samples of each cycle are fed with the timer paused, the cycle-ending sample is timed.
 void BM_CycleEndFit(benchmark::State& state) {
   const auto& rec = recording();
-  const Mode mode = state.range(0) == 0 ? Mode::Robust : Mode::Paper;
-  Calibrator cal(config(mode));
+  const int variant = static_cast<int>(state.range(0));
+  Calibrator cal(config(variant));
   // Find the indices where cycles start in this recording (same for every replay).
   std::vector<std::size_t> starts;
   {
-    Calibrator probe(config(mode));
+    Calibrator probe(config(variant));
     for (std::size_t k = 0; k < rec.time_s.size(); ++k) {
       if (probe.update({rec.time_s[k], rec.position_rev[k], rec.force_kN[k]}).cycle_start) starts.push_back(k);
     }
@@ -73,7 +77,7 @@ void BM_CycleEndFit(benchmark::State& state) {
   for (auto _ : state) {
     state.PauseTiming();
     if (next >= starts.size()) {  // replay from the beginning with a fresh calibrator state
-      cal = Calibrator(config(mode));
+      cal = Calibrator(config(variant));
       k = 0;
       next = 1;
       t_offset += span;
@@ -87,8 +91,8 @@ void BM_CycleEndFit(benchmark::State& state) {
     ++next;
   }
   state.counters["fit_ran"] = static_cast<double>(cal.stats().fits_accepted + cal.stats().fits_rejected - fits_before);
-  state.SetLabel(to_string(mode));
+  state.SetLabel(variant == 2 ? "robust+force_delay" : variant == 3 ? "robust+viscous" : to_string(cal.config().mode));
 }
-BENCHMARK(BM_CycleEndFit)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_CycleEndFit)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

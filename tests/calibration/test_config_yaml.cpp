@@ -112,3 +112,19 @@ TEST(CalibratorConfigYaml, CrossFieldRuleNamesTheField) {
   const auto e = load_broken(replace(robust_text(), "samples_L: 64", "samples_L: 10"));
   EXPECT_NE(e.rule().find("samples_L = 10"), std::string::npos) << e.what();
 }
+
+TEST(CalibratorConfigYaml, EffectTermsLoadAndTheForceDelayIsBounded) {
+  const std::string path = ::testing::TempDir() + "/effects_calibrator.yaml";
+  {
+    std::ofstream f(path);
+    f << robust_text() << "effects:\n  viscous_friction: true\n  force_delay_s: 0.005\n";
+  }
+  const auto c = load_config(path);
+  EXPECT_TRUE(c.viscous_friction);
+  EXPECT_DOUBLE_EQ(c.force_delay_s, 0.005);
+  const std::string text = robust_text() + "effects:\n  force_delay_s: 0.2\n";
+  const auto e = load_broken(text);
+  EXPECT_EQ(e.key_path(), "effects.force_delay_s");
+  EXPECT_EQ(e.line(), line_of(text, "force_delay_s"));
+  EXPECT_NE(e.rule().find("0.05"), std::string::npos) << e.what();
+}

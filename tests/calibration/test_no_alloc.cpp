@@ -12,9 +12,15 @@
 using namespace bbw::calibration;
 
 TEST(CalibratorAllocation, NoHeapAllocationPerSample) {
-  for (Mode mode : {Mode::Robust, Mode::Paper}) {
+  // Both modes, and robust mode with the optional effect terms (viscous, force delay) on.
+  for (int variant = 0; variant < 3; ++variant) {
+    const Mode mode = variant == 1 ? Mode::Paper : Mode::Robust;
     CalibratorConfig c;
     c.mode = mode;
+    if (variant == 2) {
+      c.viscous_friction = true;
+      c.force_delay_s = 0.005;
+    }
     c.elements_M = 8;
     c.samples_L = 64;
     c.x_min_rev = 0.5;
@@ -32,7 +38,7 @@ TEST(CalibratorAllocation, NoHeapAllocationPerSample) {
       sink += cal.update({rec.time_s[k], rec.position_rev[k], rec.force_kN[k]}).force_kN;
     }
     const long after = bbw::test::allocation_count();
-    EXPECT_EQ(after - before, 0) << "mode " << to_string(mode);
+    EXPECT_EQ(after - before, 0) << "mode " << to_string(mode) << (variant == 2 ? " with effect terms" : "");
     EXPECT_GE(cal.stats().fits_accepted, 8u);  // the run did exercise the cycle-end fits
     EXPECT_TRUE(std::isfinite(sink));
   }

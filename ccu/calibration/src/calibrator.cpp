@@ -95,6 +95,7 @@ Calibrator::Calibrator(const CalibratorConfig& config)
       detector_(config.start_lag_n0, robust_ ? config.start_margin_rev : 0.0),
       store_(config.samples_L, config.elements_M + (config.viscous_friction ? 1 : 0), config.x_max_rev - config.x_min_rev,
              config.f_max_kN - config.f_min_kN, config.drop_rule),
+      position_delay_(config.force_delay_s > 0.0 ? CalibratorConfig::kForceDelayCapacity : 2),
       solver_(kCurveTerms + config.elements_M + (config.viscous_friction ? 1 : 0)) {
   const auto m = static_cast<std::size_t>(m_);
   const auto p = static_cast<std::size_t>(p_);
@@ -137,7 +138,7 @@ std::size_t Calibrator::state_bytes() const {
   auto vb = [](const auto& v) { return v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type); };
   return sizeof(*this) + vb(friction_.delta_rev) + vb(friction_.stiffness_kN_per_rev) + vb(phi_kN_) +
          vb(pf_x_rev_) + vb(pf_f_kN_) + vb(pf_proj_) + (store_.bytes() - sizeof(store_)) +
-         (solver_.bytes() - sizeof(solver_)) + vb(element_pos_rev_) + vb(n_now_) + vb(vel_t_s_) + vb(vel_x_rev_) + vb(start_pos_rev_) +
+         (solver_.bytes() - sizeof(solver_)) + vb(element_pos_rev_) + vb(n_now_) + vb(vel_t_s_) + vb(vel_x_rev_) + 2 * position_delay_.capacity() * sizeof(double) + vb(start_pos_rev_) +
          vb(gram_) + vb(rhs_) + vb(theta_) + vb(row_) + vb(full_row_) + vb(n_replay_) + vb(pos_replay_) + vb(column_on_) +
          vb(column_map_) + vb(nonneg_flags_) + static_cast<std::size_t>(2 * config_.start_lag_n0 + 1) * sizeof(double);
 }
@@ -366,7 +367,11 @@ Estimate Calibrator::update(const Sample& s) {
     e.calibrated = stats_.fits_accepted > 0;
     return e;
   }
-  const double x = s.position_rev;
+  // With a force delay d the load cell at t belongs to the position at t - d: the model runs
+  // on that position and the estimate is carried to the present along the curve.
+  const bool delayed = config_.force_delay_s > 0.0;
+  if (delayed) position_delay_.push(s.time_s, s.position_rev);
+  const double x = delayed ? position_delay_.read(s.time_s - config_.force_delay_s) : s.position_rev;
   if (!have_time_) {
     first_x_rev_ = x;
     for (auto& p : element_pos_rev_) p = x;
@@ -394,7 +399,11 @@ Estimate Calibrator::update(const Sample& s) {
   const double friction = elements_step(x, friction_.delta_rev.data(), element_pos_rev_.data(),
                                         static_cast<std::size_t>(m_), nullptr, n_now_.data());
   (void)friction;
-  if (e_ > 0) n_now_[static_cast<std::size_t>(m_)] = speed_now(s) / config_.viscous_speed_scale_rev_per_s;
+  if (e_ > 0) {
+    // Delayed: the speed is the slope of the delayed positions (the sample's speed is current).
+    const Sample at_x{s.time_s, x, s.force_kN, delayed ? std::numeric_limits<double>::quiet_NaN() : s.speed_rev_s};
+    n_now_[static_cast<std::size_t>(m_)] = speed_now(at_x) / config_.viscous_speed_scale_rev_per_s;
+  }
   double f_fric = 0.0;
   for (int i = 0; i < m_ + e_; ++i) f_fric += phi_kN_[static_cast<std::size_t>(i)] * n_now_[static_cast<std::size_t>(i)];
 
@@ -405,8 +414,9 @@ Estimate Calibrator::update(const Sample& s) {
 
   e.valid = true;
   e.friction_kN = f_fric;
+  e.curve_force_kN = curve_.force_kN(s.position_rev);
   e.force_kN = s.force_kN - f_fric;
-  e.curve_force_kN = curve_.force_kN(x);
+  if (delayed) e.force_kN += e.curve_force_kN - curve_.force_kN(x);
   e.calibrated = stats_.fits_accepted > 0;
   return e;
 }

@@ -44,6 +44,7 @@ void CalibratorConfig::validate() const {
   if (!(start_margin_rev >= 0.0)) bad("start_margin_rev", start_margin_rev, "must be >= 0");
   if (!(viscous_speed_scale_rev_per_s > 0.0)) bad("viscous_speed_scale_rev_per_s", viscous_speed_scale_rev_per_s, "must be > 0");
   if (velocity_window < 2 || velocity_window > 1000) bad("velocity_window", velocity_window, "must be in [2, 1000]");
+  if (!(force_delay_s >= 0.0 && force_delay_s <= 0.05)) bad("force_delay_s", force_delay_s, "must be in [0, 0.05]");
   if (!(k_smoothing > 0.0 && k_smoothing <= 1.0)) bad("k_smoothing", k_smoothing, "must be in (0, 1]");
 }
 

@@ -65,6 +65,7 @@ CalibratorConfig read_config(Reader& r) {
     c.viscous_speed_scale_rev_per_s =
         fx->number_or("viscous_speed_scale_rev_per_s", c.viscous_speed_scale_rev_per_s, Range::positive());
     c.velocity_window = static_cast<int>(fx->integer_or("velocity_window", c.velocity_window, 2, 1000));
+    c.force_delay_s = fx->number_or("force_delay_s", c.force_delay_s, Range::closed(0.0, 0.05));
     fx->finish();
   }
   try {

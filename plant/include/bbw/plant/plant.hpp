@@ -10,7 +10,7 @@
 #include <random>
 
 #include "bbw/plant/clamp_curve.hpp"
-#include "bbw/plant/delay_line.hpp"
+#include "bbw/common/delay_line.hpp"
 #include "bbw/plant/key_friction.hpp"
 #include "bbw/plant/params.hpp"
 
@@ -87,7 +87,7 @@ class Plant {
   Conditions c_;
   ClampCurve curve_;
   KeyFriction friction_;
-  DelayLine force_delay_;
+  common::DelayLine force_delay_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
   double inertia_kg_m2_ = 0.0;        // reflected to the spindle

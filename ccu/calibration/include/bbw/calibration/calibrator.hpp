@@ -10,6 +10,7 @@
 
 #include "bbw/calibration/bounded_lsq.hpp"
 #include "bbw/calibration/config.hpp"
+#include "bbw/common/delay_line.hpp"
 #include "bbw/calibration/curve.hpp"
 #include "bbw/calibration/cycle_detector.hpp"
 #include "bbw/calibration/sample_store.hpp"
@@ -115,6 +116,7 @@ class Calibrator {
   std::vector<double> element_pos_rev_;  // live element positions x_i
   std::vector<double> n_now_;            // live n_i, then the extra regressors
   std::vector<double> vel_t_s_, vel_x_rev_;  // ring of recent samples for the speed fallback
+  common::DelayLine position_delay_;     // positions for the force-delay term (2 slots when off)
   std::size_t vel_head_ = 0, vel_count_ = 0;
   double speed_now(const Sample& s);
   std::vector<double> start_pos_rev_;    // x0_i at the current cycle's start (replay)

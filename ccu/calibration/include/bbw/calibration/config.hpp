@@ -1,6 +1,8 @@
 // Calibrator settings. Plain struct; validate() names the field, value and rule it breaks.
 #pragma once
 
+#include <cstddef>
+
 #include <string>
 
 #include "bbw/calibration/curve.hpp"
@@ -56,6 +58,13 @@ struct CalibratorConfig {
   bool viscous_friction = false;
   double viscous_speed_scale_rev_per_s = 10.0;  // regressor scaling inside the fit
   int velocity_window = 9;                      // samples, for the position-slope fallback
+  // force_delay_s: the load cell lags the resolver by this much (a sensor or filter delay
+  // ./bbw analyze measures; 0 = off, at most 0.05). The model pairs each load-cell reading with
+  // the position force_delay_s earlier (a 128-sample delay line: enough at up to 2.5 kHz), and
+  // the estimate is carried to the present along the curve:
+  //   f_hat(t) = f_c(t) - friction(x(t - d)) + C(x(t)) - C(x(t - d)).
+  double force_delay_s = 0.0;
+  static constexpr std::size_t kForceDelayCapacity = 128;
 
   // Throws std::invalid_argument naming the field, its value and the rule.
   void validate() const;
