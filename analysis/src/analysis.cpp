@@ -730,4 +730,17 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
   return res;
 }
 
+std::vector<CalibratorTerm> calibrator_terms(const AnalysisResult& r) {
+  std::vector<CalibratorTerm> out;
+  for (const Step& s : r.steps) {
+    if (s.evidence.name == "viscous_friction") out.push_back({"viscous_friction", 1.0});
+    if (s.evidence.name == "sensor_delay") {
+      for (const Parameter& p : r.final_parameters) {
+        if (p.name == "sensor_delay.delay_s") out.push_back({"force_delay_s", p.value});
+      }
+    }
+  }
+  return out;
+}
+
 }  // namespace bbw::analysis

@@ -59,8 +59,15 @@ TEST(AnalyzeCli, WritesJsonReportAndPlots) {
   js << j.rdbuf();
   for (const char* key : {"\"baseline\"", "\"final\"", "\"rms_residual\"", "\"max_residual\"", "\"rms_truth_error\"",
                           "\"max_truth_error\"", "\"force_unit\": \"kN\"", "\"steps\"", "\"rejected\"",
-                          "\"unexplained_structure\"", "\"structure_tests\"", "\"name\": \"viscous_friction\""})
+                          "\"unexplained_structure\"", "\"structure_tests\"", "\"name\": \"viscous_friction\"",
+                          "\"calibrator_effects\": {", "\"viscous_friction\": true"})
     EXPECT_NE(js.str().find(key), std::string::npos) << key;
+  {
+    std::ifstream md(dir / "out" / "report.md");
+    std::stringstream ms;
+    ms << md.rdbuf();
+    EXPECT_NE(ms.str().find("effects:\n  viscous_friction: true\n"), std::string::npos) << ms.str();
+  }
   for (const char* f : {"report.md", "residual_time.png", "residual_vs_regressor.png", "truth_error_time.png"})
     EXPECT_GT(fs::file_size(dir / "out" / f), 100u) << f;
   fs::remove_all(dir);

@@ -5,12 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
 
 #include "bbw/analysis/analysis.hpp"
+#include "bbw/calibration/config_yaml.hpp"
+#include "bbw/calibration/offline.hpp"
 #include "bbw/scenario/corner_sim.hpp"
 #include "bbw/scenario/load.hpp"
 
@@ -103,10 +106,41 @@ INSTANTIATE_TEST_SUITE_P(PaperRig, PlantEffect,
                          ::testing::Values("viscous_friction", "load_dependent_friction", "sensor_delay",
                                            "thermal_drift", "backlash", "creep"));
 
+// The whole loop for the effects that have an online term: analyze the recording, switch on
+// the calibrator terms the analysis calls for (calibrator_terms), and the online calibrator's
+// worst case on the same recording at least halves.
+class OnlineTerm : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(OnlineTerm, WhatTheAnalysisFindsSwitchedOnInTheCalibratorHalvesItsError) {
+  const analysis::Recording rec = record({GetParam()});
+  const auto r = analysis::analyze(rec, analysis::AnalysisOptions{});
+  const auto terms = analysis::calibrator_terms(r);
+  ASSERT_EQ(terms.size(), 1u) << describe(r);
+  auto off = calibration::load_config(source_dir() + "/config/calibrator/robust.yaml");
+  auto on = off;
+  if (GetParam() == "sensor_delay") {
+    EXPECT_EQ(terms[0].key, "force_delay_s");
+    EXPECT_NEAR(terms[0].value, 0.005, 0.001);  // the plant's delay
+    on.force_delay_s = terms[0].value;
+  } else {
+    EXPECT_EQ(terms[0].key, "viscous_friction");
+    on.viscous_friction = true;
+  }
+  calibration::Recording online{rec.time_s, rec.position, rec.force, rec.truth, rec.velocity};
+  const auto before = calibration::run_recording(off, online);
+  const auto after = calibration::run_recording(on, online);
+  std::printf("%s: online worst case %.3f -> %.3f kN with %s = %g\n", GetParam().c_str(),
+              before.score.max_abs_error_kN, after.score.max_abs_error_kN, terms[0].key.c_str(), terms[0].value);
+  EXPECT_LE(after.score.max_abs_error_kN, 0.5 * before.score.max_abs_error_kN);
+}
+
+INSTANTIATE_TEST_SUITE_P(PaperRig, OnlineTerm, ::testing::Values("viscous_friction", "sensor_delay"));
+
 TEST(PlantNoEffect, AddsNothingAndReportsNoStructure) {
   const auto r = analysis::analyze(record({}), analysis::AnalysisOptions{});
   EXPECT_TRUE(r.steps.empty()) << describe(r);
   EXPECT_FALSE(r.unexplained_structure) << describe(r);
+  EXPECT_TRUE(analysis::calibrator_terms(r).empty());
 }
 
 TEST(PlantTwoEffects, FindsBoth) {

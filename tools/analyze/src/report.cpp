@@ -116,6 +116,13 @@ std::string analysis_json(const LoadedRecording& in, const analysis::AnalysisOpt
     w.end_object();
   }
   w.end_array();
+  // What to switch on in the online calibrator's config (`effects:`), docs/calibrator.md.
+  w.begin_object("calibrator_effects");
+  for (const auto& t : analysis::calibrator_terms(r)) {
+    if (t.key == "viscous_friction") w.value(t.key, true);
+    else w.value(t.key, t.value);
+  }
+  w.end_object();
   w.begin_array("rejected");
   for (const auto& s : r.rejected) {
     w.begin_object();
@@ -246,6 +253,19 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
        << s.runner_up << " (" << fmt(100.0 * s.runner_up_relative_drop, 3) << " %). Parameters:";
     for (const auto& p : s.parameters) md << " " << p.name << " = " << fmt(p.value) << " " << p.unit << ";";
     md << "\n";
+  }
+  const auto terms = analysis::calibrator_terms(r);
+  md << "\n## Back into the online calibrator\n\n";
+  if (terms.empty()) {
+    md << "None of the accepted effects has an online calibrator term (available: viscous_friction, "
+          "sensor_delay).\n";
+  } else {
+    md << "For a caliper recording (position in rev, force in kN), add to the calibrator config "
+          "(docs/calibrator.md, \"Optional effect terms\"):\n\n```yaml\neffects:\n";
+    for (const auto& t : terms) {
+      md << "  " << t.key << ": " << (t.key == "viscous_friction" ? std::string("true") : fmt(t.value)) << "\n";
+    }
+    md << "```\n";
   }
   md << "\n## Rejected (last round)\n\n| candidate | held-out RMS | drop | t |\n|---|---|---|---|\n";
   for (const auto& s : r.rejected)

@@ -106,4 +106,14 @@ struct AnalysisResult {
 // mismatched lengths, non-uniform or non-increasing time, constant position).
 AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options);
 
+// The online calibrator's optional effect terms (its config's `effects:` keys,
+// docs/calibrator.md) that the accepted steps call for: viscous_friction -> viscous_friction = 1
+// (on; the calibrator fits c_v itself), sensor_delay -> force_delay_s = the measured delay.
+// Effects without an online term give none.
+struct CalibratorTerm {
+  std::string key;
+  double value = 0.0;
+};
+std::vector<CalibratorTerm> calibrator_terms(const AnalysisResult& r);
+
 }  // namespace bbw::analysis
