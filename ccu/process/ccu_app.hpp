@@ -36,17 +36,13 @@ using dds::kExitPeerLost;
 using dds::kExitRuntime;
 using dds::kExitUsage;
 
-struct CcuOptions {
-  ClockMode mode = ClockMode::Lockstep;
-  dds::ParticipantOptions participant;
-  std::chrono::milliseconds discovery_timeout{20000};
-  std::chrono::milliseconds peer_timeout{10000};  // lockstep: longest wait for a block
+// Mode, participant, timeouts and process_faults from dds::ProcessOptions. With
+// process_faults the CCU freezes itself (SIGSTOP) at its scheduled kill time for the launcher to
+// SIGKILL it, and in lockstep holds the clock at a corner's scheduled restart until the new
+// process has joined.
+struct CcuOptions : dds::ProcessOptions {
   std::string out_dir;                            // per-corner CSVs and ccu.stats; "" for none
   bool friction_feedback = true;                  // let corners use compensated feedback
-  // Process faults of the schedule are carried out (the launcher runs the process): the CCU
-  // freezes itself (SIGSTOP) at its scheduled kill time for the launcher to SIGKILL it, and in
-  // lockstep holds the clock at a corner's scheduled restart until the new process has joined.
-  bool process_faults = false;
   faults::FaultSchedule schedule;
 };
 

@@ -30,19 +30,16 @@ namespace bbw::corner_process {
 
 using dds::ClockMode;
 
-struct CornerOptions {
+// Mode, participant, timeouts and process_faults from dds::ProcessOptions.
+struct CornerOptions : dds::ProcessOptions {
   dds::Corner corner = dds::Corner::FL;
   std::size_t scenario_index = 0;               // the corner's index in the scenario
-  ClockMode mode = ClockMode::Lockstep;
-  dds::ParticipantOptions participant;
-  std::chrono::milliseconds discovery_timeout{20000};
   // Longest wait for the CCU's endpoints to match (0: discovery_timeout). With DDS Security
   // main() sets a shorter one and, when it passes, starts over with a new participant: Fast
   // DDS 2.9 sometimes loses the security handshake of one pair when several participants start
   // together and never retries it (a race in its SecurityManager, fixed upstream after 2.9,
   // eProsima/Fast-DDS#4188); a new participant is a new handshake.
   std::chrono::milliseconds match_timeout{0};
-  std::chrono::milliseconds peer_timeout{10000};  // lockstep: longest wait for the next command
   std::string stats_file;                        // JSON with counters and jitter; "" for none
   std::string periods_log;                       // per-period CSV (truth, applied command); "" for none
   // Fault injection (docs/faults.md): sensor and actuator faults through FaultInjector, network
@@ -50,7 +47,6 @@ struct CornerOptions {
   // process_faults (the launcher carries them out): at its scheduled kill the corner freezes
   // (SIGSTOP) for the launcher to SIGKILL it.
   faults::FaultSchedule schedule;
-  bool process_faults = false;
   faults::CcuWatchdogParams watchdog;
   // A restarted process: its number and the simulated time it rejoins at (it starts at the
   // first period at or after it, from a released plant, with sample seq 1).

@@ -84,11 +84,7 @@ int main(int argc, char** argv) {
     std::cerr << "bbw_corner: " << e.what() << "\n" << usage();
     return kExitUsage;
   }
-  opt.mode = flags.mode;
-  opt.participant = flags.participant;
-  opt.discovery_timeout = flags.discovery_timeout;
-  opt.peer_timeout = flags.peer_timeout;
-  opt.process_faults = flags.process_faults;
+  static_cast<bbw::dds::ProcessOptions&>(opt) = flags.options;
   const std::string& secure_dir = flags.secure_dir;
   const std::string& scenario_file = flags.scenario_file;
 

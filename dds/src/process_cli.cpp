@@ -38,20 +38,20 @@ ClockMode parse_clock_mode(const std::string& text) {
 bool ProcessFlags::take(const std::string& flag, ArgCursor& args) {
   if (flag == "--scenario") scenario_file = args.value();
   else if (flag == "--domain") domain_arg = args.value();
-  else if (flag == "--mode") mode = parse_clock_mode(mode_name = args.value());
-  else if (flag == "--discovery-timeout") discovery_timeout = seconds_arg(flag, args.value());
-  else if (flag == "--peer-timeout") peer_timeout = seconds_arg(flag, args.value());
-  else if (flag == "--dds-profiles") participant.profiles_file = args.value();
-  else if (flag == "--dds-participant-profile") participant.profile = args.value();
+  else if (flag == "--mode") options.mode = parse_clock_mode(mode_name = args.value());
+  else if (flag == "--discovery-timeout") options.discovery_timeout = seconds_arg(flag, args.value());
+  else if (flag == "--peer-timeout") options.peer_timeout = seconds_arg(flag, args.value());
+  else if (flag == "--dds-profiles") options.participant.profiles_file = args.value();
+  else if (flag == "--dds-participant-profile") options.participant.profile = args.value();
   else if (flag == "--secure") secure_dir = args.value();
-  else if (flag == "--process-faults") process_faults = true;
+  else if (flag == "--process-faults") options.process_faults = true;
   else return false;
   return true;
 }
 
 void ProcessFlags::finish(const char* env_domain) {
   if (scenario_file.empty()) throw std::invalid_argument("--scenario is required");
-  participant.domain_id = resolve_domain_id(domain_arg, env_domain);
+  options.participant.domain_id = resolve_domain_id(domain_arg, env_domain);
 }
 
 std::string process_usage(const std::string& program, const std::string& lead,

@@ -70,6 +70,13 @@ int main(int argc, char** argv) {
     bbw::dds::Writer<bbw::msg::ClampCommandPubSubType> commands(
         participant, bbw::dds::kCommandTopic, profiles.command_writer, events);
     std::cout << "bbw_dds_echo: domain " << domain << ", mode " << mode << ", waiting" << std::endl;
+    // A reply written before our command writer has matched the peer's reader is lost (volatile
+    // durability): it once cost DdsTwoProcess its 5 s reply wait. Blocks that arrive meanwhile
+    // wait in the reader's history.
+    if (!commands.wait_for_matched(1, std::chrono::seconds(20))) {
+      std::cerr << "bbw_dds_echo: no command reader matched within 20 s\n";
+      return 3;
+    }
     long long echoed = 0;
     bbw::msg::MeasurementBlock in;
     bbw::msg::ClampCommand out;

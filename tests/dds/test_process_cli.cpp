@@ -48,31 +48,31 @@ TEST(ProcessCli, TakesEverySharedFlagAndLeavesTheOthers) {
   f.finish("99");
   EXPECT_EQ(rest, (std::vector<std::string>{"--corner", "--out"}));
   EXPECT_EQ(f.scenario_file, "s.yaml");
-  EXPECT_EQ(f.participant.domain_id, 17);
-  EXPECT_EQ(f.mode, ClockMode::Realtime);
+  EXPECT_EQ(f.options.participant.domain_id, 17);
+  EXPECT_EQ(f.options.mode, ClockMode::Realtime);
   EXPECT_EQ(f.mode_name, "realtime");
-  EXPECT_EQ(f.discovery_timeout.count(), 2500);
-  EXPECT_EQ(f.peer_timeout.count(), 250);
-  EXPECT_EQ(f.participant.profiles_file, "p.xml");
-  EXPECT_EQ(f.participant.profile, "bbw_network");
+  EXPECT_EQ(f.options.discovery_timeout.count(), 2500);
+  EXPECT_EQ(f.options.peer_timeout.count(), 250);
+  EXPECT_EQ(f.options.participant.profiles_file, "p.xml");
+  EXPECT_EQ(f.options.participant.profile, "bbw_network");
   EXPECT_EQ(f.secure_dir, "keys");
-  EXPECT_TRUE(f.process_faults);
+  EXPECT_TRUE(f.options.process_faults);
 }
 
 TEST(ProcessCli, DefaultsAndTheDomainFromTheEnvironment) {
   ProcessFlags f;
   parse(f, {"--scenario", "s.yaml"});
   f.finish("42");
-  EXPECT_EQ(f.participant.domain_id, 42);
-  EXPECT_EQ(f.mode, ClockMode::Lockstep);
-  EXPECT_EQ(f.discovery_timeout.count(), 20000);
-  EXPECT_EQ(f.peer_timeout.count(), 10000);
+  EXPECT_EQ(f.options.participant.domain_id, 42);
+  EXPECT_EQ(f.options.mode, ClockMode::Lockstep);
+  EXPECT_EQ(f.options.discovery_timeout.count(), 20000);
+  EXPECT_EQ(f.options.peer_timeout.count(), 10000);
   EXPECT_TRUE(f.secure_dir.empty());
-  EXPECT_FALSE(f.process_faults);
+  EXPECT_FALSE(f.options.process_faults);
   ProcessFlags g;
   parse(g, {"--scenario", "s.yaml"});
   g.finish(nullptr);
-  EXPECT_EQ(g.participant.domain_id, 0);
+  EXPECT_EQ(g.options.participant.domain_id, 0);
 }
 
 TEST(ProcessCli, BadInputNamesTheFlagAndTheRule) {

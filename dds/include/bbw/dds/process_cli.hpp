@@ -45,19 +45,26 @@ std::chrono::milliseconds seconds_arg(const std::string& flag, const std::string
 // "lockstep" or "realtime"; throws naming --mode otherwise.
 ClockMode parse_clock_mode(const std::string& text);
 
+// The options both processes run with (CcuOptions and CornerOptions extend them).
+struct ProcessOptions {
+  ClockMode mode = ClockMode::Lockstep;
+  ParticipantOptions participant;
+  std::chrono::milliseconds discovery_timeout{20000};
+  // Lockstep: the longest wait for the peer's next block (CCU) or command (corner).
+  std::chrono::milliseconds peer_timeout{10000};
+  // Process faults of the schedule are carried out (bbw_launch runs the process and kills it).
+  bool process_faults = false;
+};
+
 // The flags both processes take. take() consumes one of them from the cursor; finish() checks
 // what must hold once all are read (--scenario given) and resolves the domain id (--domain,
-// else env BBW_DOMAIN, else 0).
+// else env BBW_DOMAIN, else 0) into options.participant.
 struct ProcessFlags {
   std::string scenario_file;
   std::string mode_name = "lockstep";
-  ClockMode mode = ClockMode::Lockstep;
   std::optional<std::string> domain_arg;
-  std::chrono::milliseconds discovery_timeout{20000};
-  std::chrono::milliseconds peer_timeout{10000};
   std::string secure_dir;  // "" without DDS Security
-  bool process_faults = false;
-  ParticipantOptions participant;
+  ProcessOptions options;
 
   // true when `flag` is one of the shared flags (its value, if any, taken from `args`).
   bool take(const std::string& flag, ArgCursor& args);
