@@ -8,6 +8,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <sstream>
 #include <string>
@@ -30,11 +31,21 @@ std::string scratch(const std::string& test) { return bbw::system_test::scratch(
 
 using LaunchRun = bbw::system_test::ProcessRun;
 
+// Runs the launcher; on the Fast DDS 2.9 discovery abort (and only on it: any other failure is
+// returned as it is) the run is repeated, at most twice, with a note in the test's output.
 LaunchRun launch(const std::string& scenario, const std::string& dir, int domain, const std::string& mode) {
-  return run("bbw_launch",
-             {bin("bbw_launch"), src(scenario), "--out", dir + "/out", "--mode", mode, "--domain",
-              std::to_string(domain), "--discovery-timeout", "20", "--no-report"},
-             dir, 170s);
+  for (int attempt = 1;; ++attempt) {
+    LaunchRun r = run("bbw_launch",
+                      {bin("bbw_launch"), src(scenario), "--out", dir + "/out", "--mode", mode, "--domain",
+                       std::to_string(domain), "--discovery-timeout", "20", "--no-report"},
+                      dir, 170s);
+    const std::string abort_file = r.status.ok() ? "" : fastdds_pdp_abort(dir + "/out");
+    if (abort_file.empty() || attempt == 3) return r;
+    std::cout << "[ NOTE     ] run " << attempt << " of " << scenario
+              << " hit the Fast DDS 2.9 discovery assertion (docs/faults.md), in " << abort_file
+              << "; running it again\n";
+    fs::remove_all(dir + "/out");
+  }
 }
 
 // A flat reading of summary.json's "faults" and "detections" arrays: one map per object, string
@@ -144,7 +155,9 @@ TEST_P(LockstepFault, IsDetectedAndDiagnosedRight) {
     EXPECT_EQ(f.at("correct"), "true") << f.at("corner") << " " << f.at("type") << ": diagnosis " << f.at("diagnosis");
     EXPECT_GE(num(f, "latency_ms"), 0.0);
     EXPECT_LT(num(f, "latency_ms"), 500.0) << f.at("type");  // drift is the slowest (~380 ms)
-    if (f.at("part") == "load_cell" && f.at("type") == "bias") EXPECT_LE(num(f, "latency_ms"), 100.0);
+    if (f.at("part") == "load_cell" && f.at("type") == "bias") {
+      EXPECT_LE(num(f, "latency_ms"), 100.0);
+    }
     if (f.at("corner") == "CCU") continue;
     for (const auto& d : detections) {
       EXPECT_EQ(d.at("corner"), f.at("corner")) << "a fault raised on another corner: " << d.at("finding");
@@ -247,7 +260,9 @@ TEST(SystemFaultsRealtime, ARestartedCornerIsNamedAsAProcessLossAndRejoins) {
   // On the other corners at most a late period (link_lost, when this shared machine stalls a
   // process beyond the 15 ms deadline); never a sensor, actuator or process finding.
   for (const auto& d : objects(summary, "detections")) {
-    if (d.at("corner") != "RR") EXPECT_EQ(d.at("finding"), "link_lost") << d.at("corner");
+    if (d.at("corner") != "RR") {
+      EXPECT_EQ(d.at("finding"), "link_lost") << d.at("corner");
+    }
   }
   // Realtime: the last sample before the kill is within a period of 1.0 s; the new process
   // starts at the CCU's current period once it has joined (1.531-1.641 s in 8 runs), never
