@@ -457,6 +457,7 @@ std::vector<Parameter> model_parameters(const Context& c, const Spec& s, const E
       case EffectKind::Inertia: out.push_back({p + "mass", b(j++), "force/(position/s^2)"}); break;
       case EffectKind::LoadDependentFriction:
         out.push_back({p + "friction_gain_at_full_curve", b(j++), "1"});
+        out.push_back({p + "reference_force", c.ref_curve_scale, "force"});  // the full curve's |force|
         break;
       case EffectKind::TemperatureDrift:
         out.push_back({p + "sensor_offset_per_degC", b(j++), "force/degC"});
@@ -734,9 +735,14 @@ std::vector<CalibratorTerm> calibrator_terms(const AnalysisResult& r) {
   std::vector<CalibratorTerm> out;
   for (const Step& s : r.steps) {
     if (s.evidence.name == "viscous_friction") out.push_back({"viscous_friction", 1.0});
-    if (s.evidence.name == "sensor_delay") {
-      for (const Parameter& p : r.final_parameters) {
-        if (p.name == "sensor_delay.delay_s") out.push_back({"force_delay_s", p.value});
+    for (const Parameter& p : r.final_parameters) {
+      if (s.evidence.name == "sensor_delay" && p.name == "sensor_delay.delay_s") out.push_back({"force_delay_s", p.value});
+      if (s.evidence.name == "backlash" && p.name == "backlash.width") out.push_back({"backlash_width_rev", p.value});
+      if (s.evidence.name == "load_dependent_friction") {
+        if (p.name == "load_dependent_friction.friction_gain_at_full_curve") {
+          out.push_back({"load_friction_gain", std::clamp(p.value, 0.0, 10.0)});
+        }
+        if (p.name == "load_dependent_friction.reference_force") out.push_back({"load_friction_reference_kN", p.value});
       }
     }
   }

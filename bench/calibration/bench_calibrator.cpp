@@ -21,16 +21,32 @@ const Recording& recording() {
 }
 
 // Arg 0: robust, 1: paper, 2: robust with the optional 5 ms force-delay term, 3: robust with the
-// optional viscous term (speed from the position slope: the recording has no speed channel).
+// optional viscous term (speed from the position slope: the recording has no speed channel),
+// 4: robust with a 0.05 rev backlash term, 5: robust with the load-dependent friction term.
 CalibratorConfig config(int variant) {
   auto c = load_config(std::string(BBW_SOURCE_DIR) + "/config/calibrator/robust.yaml");
   c.mode = variant == 1 ? Mode::Paper : Mode::Robust;
   if (variant == 2) c.force_delay_s = 0.005;
   if (variant == 3) c.viscous_friction = true;
+  if (variant == 4) c.backlash_width_rev = 0.05;
+  if (variant == 5) {
+    c.load_friction_gain = 0.9;
+    c.load_friction_reference_kN = 36.0;
+  }
   c.elements_M = 8;
   c.samples_L = 64;
   c.pf_points_N = 20;
   return c;
+}
+
+const char* variant_label(int variant, const Calibrator& cal) {
+  switch (variant) {
+    case 2: return "robust+force_delay";
+    case 3: return "robust+viscous";
+    case 4: return "robust+backlash";
+    case 5: return "robust+load_friction";
+    default: return to_string(cal.config().mode);
+  }
 }
 
 // Per-sample cost including the amortised cycle-end fits: one iteration = one sample; the
@@ -52,9 +68,9 @@ void BM_CalibratorUpdate(benchmark::State& state) {
   }
   state.counters["fits"] = static_cast<double>(cal.stats().fits_accepted + cal.stats().fits_rejected);
   state.counters["state_bytes"] = static_cast<double>(cal.state_bytes());
-  state.SetLabel(variant == 2 ? "robust+force_delay" : variant == 3 ? "robust+viscous" : to_string(cal.config().mode));
+  state.SetLabel(variant_label(variant, cal));
 }
-BENCHMARK(BM_CalibratorUpdate)->Arg(0)->Arg(1)->Arg(2)->Arg(3);
+BENCHMARK(BM_CalibratorUpdate)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4)->Arg(5);
 
 // Cost of the one update() that ends a cycle (the fit, PF update and global refit): the
 // samples of each cycle are fed with the timer paused, the cycle-ending sample is timed.
@@ -91,8 +107,8 @@ void BM_CycleEndFit(benchmark::State& state) {
     ++next;
   }
   state.counters["fit_ran"] = static_cast<double>(cal.stats().fits_accepted + cal.stats().fits_rejected - fits_before);
-  state.SetLabel(variant == 2 ? "robust+force_delay" : variant == 3 ? "robust+viscous" : to_string(cal.config().mode));
+  state.SetLabel(variant_label(variant, cal));
 }
-BENCHMARK(BM_CycleEndFit)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_CycleEndFit)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4)->Arg(5)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -139,3 +139,48 @@ TEST(Calibrator, ResetCurveRestartsFromGivenCurve) {
   EXPECT_DOUBLE_EQ(cal.curve().force_kN(2.0), 5.0);
   EXPECT_DOUBLE_EQ(cal.pf_forces_kN().front(), 2.0 * 0.5 + 1.0);
 }
+
+// Backlash term, worked by hand: width 0.05 rev (half 0.025). The spindle starts at the first
+// position and is dragged along only once the resolver is half the play away from it.
+TEST(Calibrator, BacklashTermRunsTheModelOnTheSpindlePosition) {
+  auto c = base_config(Mode::Robust);
+  c.initial_curve = Curve{0.0, 0.0, 10.0, 0.0};  // C(x) = 10 x kN
+  c.backlash_width_rev = 0.05;
+  Calibrator cal(c);
+  const double x[] = {1.0, 1.1, 1.2, 1.19, 1.18, 1.14, 1.3};
+  const double spindle[] = {1.0, 1.075, 1.175, 1.175, 1.175, 1.165, 1.275};
+  for (int k = 0; k < 7; ++k) {
+    const Estimate e = cal.update({0.001 * (k + 1), x[k], 5.0});
+    ASSERT_TRUE(e.valid);
+    EXPECT_NEAR(e.curve_force_kN, 10.0 * spindle[k], 1e-12) << "sample " << k;
+  }
+  // Off: the curve is read at the resolver position.
+  c.backlash_width_rev = 0.0;
+  Calibrator plain(c);
+  EXPECT_NEAR(plain.update({0.001, 1.19, 5.0}).curve_force_kN, 11.9, 1e-12);
+}
+
+// Load-dependent friction term: with the same stiffnesses, the friction estimate is the plain
+// one times 1 + g max(C(x), 0) / F_ref, C the current curve.
+TEST(Calibrator, LoadFrictionTermScalesTheFrictionWithTheCurveForce) {
+  auto c = base_config(Mode::Robust);
+  c.initial_curve = Curve{0.0, 0.0, 10.0, -10.0};  // C(x) = 10 (x - 1) kN: negative below 1 rev
+  Calibrator plain(c);
+  c.load_friction_gain = 0.8;
+  c.load_friction_reference_kN = 40.0;
+  Calibrator loaded(c);
+  const std::vector<double> k(6, 2.0);
+  plain.set_friction_stiffness(k);
+  loaded.set_friction_stiffness(k);
+  int checked = 0;
+  for (int j = 0; j < 400; ++j) {
+    const double x = 2.0 + 1.5 * std::sin(0.02 * j);  // 0.5 .. 3.5 rev, both directions
+    const Estimate a = plain.update({0.001 * (j + 1), x, 20.0});
+    const Estimate b = loaded.update({0.001 * (j + 1), x, 20.0});
+    const double scale = 1.0 + 0.8 * std::max(10.0 * (x - 1.0), 0.0) / 40.0;
+    EXPECT_NEAR(b.friction_kN, a.friction_kN * scale, 1e-9) << "x " << x;
+    EXPECT_NEAR(b.force_kN, 20.0 - b.friction_kN, 1e-12);
+    checked += std::fabs(a.friction_kN) > 0.1 ? 1 : 0;
+  }
+  EXPECT_GT(checked, 100);  // the friction was not zero throughout
+}

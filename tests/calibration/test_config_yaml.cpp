@@ -128,3 +128,29 @@ TEST(CalibratorConfigYaml, EffectTermsLoadAndTheForceDelayIsBounded) {
   EXPECT_EQ(e.line(), line_of(text, "force_delay_s"));
   EXPECT_NE(e.rule().find("0.05"), std::string::npos) << e.what();
 }
+
+TEST(CalibratorConfigYaml, BacklashAndLoadFrictionTermsLoadAndAreBounded) {
+  const std::string path = ::testing::TempDir() + "/effects2_calibrator.yaml";
+  {
+    std::ofstream f(path);
+    f << robust_text()
+      << "effects:\n  backlash_width_rev: 0.042\n  load_friction_gain: 0.9\n  load_friction_reference_kN: 35.7\n";
+  }
+  const auto c = load_config(path);
+  EXPECT_DOUBLE_EQ(c.backlash_width_rev, 0.042);
+  EXPECT_DOUBLE_EQ(c.load_friction_gain, 0.9);
+  EXPECT_DOUBLE_EQ(c.load_friction_reference_kN, 35.7);
+  struct Case {
+    const char* key;
+    const char* value;
+    const char* rule_part;
+  };
+  for (const Case& k : {Case{"backlash_width_rev", "0.6", "0.5"}, Case{"load_friction_gain", "-0.1", "0"},
+                        Case{"load_friction_gain", "11", "10"}, Case{"load_friction_reference_kN", "0", ">"}}) {
+    const std::string text = robust_text() + "effects:\n  " + k.key + ": " + k.value + "\n";
+    const auto e = load_broken(text);
+    EXPECT_EQ(e.key_path(), std::string("effects.") + k.key);
+    EXPECT_EQ(e.line(), line_of(text, k.key));
+    EXPECT_NE(e.rule().find(k.rule_part), std::string::npos) << e.what();
+  }
+}

@@ -12,7 +12,8 @@
 using namespace bbw::calibration;
 
 TEST(CalibratorAllocation, NoHeapAllocationPerSample) {
-  // Both modes, and robust mode with the optional effect terms (viscous, force delay) on.
+  // Both modes, and robust mode with every optional effect term (viscous, force delay,
+  // backlash, load-dependent friction) on.
   for (int variant = 0; variant < 3; ++variant) {
     const Mode mode = variant == 1 ? Mode::Paper : Mode::Robust;
     CalibratorConfig c;
@@ -20,6 +21,8 @@ TEST(CalibratorAllocation, NoHeapAllocationPerSample) {
     if (variant == 2) {
       c.viscous_friction = true;
       c.force_delay_s = 0.005;
+      c.backlash_width_rev = 0.02;
+      c.load_friction_gain = 0.5;
     }
     c.elements_M = 8;
     c.samples_L = 64;

@@ -171,7 +171,9 @@ TEST(FaultMonitor, DropoutNeedsConsecutiveMissingValues) {
   for (int k = 1; k < 60; ++k) {
     const bool gap = (k % 5 == 0) || (k >= 40 && k < 40 + p.dropout_samples);
     m.update(at(k, 0.001 * k), gap ? missing : ok, nullptr, 5.0, 0.001 * k);
-    if (k < 40 + p.dropout_samples - 1) ASSERT_TRUE(m.ok(Part::LoadCell)) << k;
+    if (k < 40 + p.dropout_samples - 1) {
+      ASSERT_TRUE(m.ok(Part::LoadCell)) << k;
+    }
   }
   EXPECT_EQ(m.diagnosis(Part::LoadCell).finding, Finding::LoadCellMissing);
   EXPECT_NEAR(m.diagnosis(Part::LoadCell).onset_s, 0.040, 1e-9);

@@ -209,6 +209,8 @@ void Calibrator::for_each_fit_row(std::size_t columns, F&& f) {
     if (!streaming_) {
       elements_step(x, friction_.delta_rev.data(), pos_replay_.data(), static_cast<std::size_t>(m_), nullptr,
                     n_replay_.data());
+      const double scale = load_scale(x);
+      for (int i = 0; i < m_; ++i) n_replay_[static_cast<std::size_t>(i)] *= scale;
       for (int i = 0; i < e_; ++i) n_replay_[static_cast<std::size_t>(m_ + i)] = n[m_ + i];
       n = n_replay_.data();
     }
@@ -326,6 +328,11 @@ void Calibrator::refit_curve_from_pf() {
   curve_ = raw_from_scaled(c, xc_rev_, xh_rev_);
 }
 
+double Calibrator::load_scale(double x_rev) const {
+  if (config_.load_friction_gain <= 0.0) return 1.0;
+  return 1.0 + config_.load_friction_gain * std::max(curve_.force_kN(x_rev), 0.0) / config_.load_friction_reference_kN;
+}
+
 // Resolver speed when the sample carries one; else the least-squares slope of the last
 // velocity_window positions (causal: it lags by about half the window).
 double Calibrator::speed_now(const Sample& s) {
@@ -371,7 +378,18 @@ Estimate Calibrator::update(const Sample& s) {
   // on that position and the estimate is carried to the present along the curve.
   const bool delayed = config_.force_delay_s > 0.0;
   if (delayed) position_delay_.push(s.time_s, s.position_rev);
-  const double x = delayed ? position_delay_.read(s.time_s - config_.force_delay_s) : s.position_rev;
+  double x = delayed ? position_delay_.read(s.time_s - config_.force_delay_s) : s.position_rev;
+  // The position the clamp force belongs to now (the curve estimate's argument).
+  double x_now = s.position_rev;
+  if (config_.backlash_width_rev > 0.0) {
+    // The model runs on the spindle position; with a delay too, the play acts on the delayed
+    // position and the present spindle is the play state pulled along to the present position.
+    const double half = 0.5 * config_.backlash_width_rev;
+    if (!have_time_) spindle_rev_ = x;
+    spindle_rev_ = std::clamp(spindle_rev_, x - half, x + half);
+    x = spindle_rev_;
+    x_now = delayed ? std::clamp(spindle_rev_, s.position_rev - half, s.position_rev + half) : x;
+  }
   if (!have_time_) {
     first_x_rev_ = x;
     for (auto& p : element_pos_rev_) p = x;
@@ -399,6 +417,10 @@ Estimate Calibrator::update(const Sample& s) {
   const double friction = elements_step(x, friction_.delta_rev.data(), element_pos_rev_.data(),
                                         static_cast<std::size_t>(m_), nullptr, n_now_.data());
   (void)friction;
+  if (config_.load_friction_gain > 0.0) {
+    const double scale = load_scale(x);
+    for (int i = 0; i < m_; ++i) n_now_[static_cast<std::size_t>(i)] *= scale;
+  }
   if (e_ > 0) {
     // Delayed: the speed is the slope of the delayed positions (the sample's speed is current).
     const Sample at_x{s.time_s, x, s.force_kN, delayed ? std::numeric_limits<double>::quiet_NaN() : s.speed_rev_s};
@@ -414,7 +436,7 @@ Estimate Calibrator::update(const Sample& s) {
 
   e.valid = true;
   e.friction_kN = f_fric;
-  e.curve_force_kN = curve_.force_kN(s.position_rev);
+  e.curve_force_kN = curve_.force_kN(x_now);
   e.force_kN = s.force_kN - f_fric;
   if (delayed) e.force_kN += e.curve_force_kN - curve_.force_kN(x);
   e.calibrated = stats_.fits_accepted > 0;

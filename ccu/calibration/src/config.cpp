@@ -45,6 +45,9 @@ void CalibratorConfig::validate() const {
   if (!(viscous_speed_scale_rev_per_s > 0.0)) bad("viscous_speed_scale_rev_per_s", viscous_speed_scale_rev_per_s, "must be > 0");
   if (velocity_window < 2 || velocity_window > 1000) bad("velocity_window", velocity_window, "must be in [2, 1000]");
   if (!(force_delay_s >= 0.0 && force_delay_s <= 0.05)) bad("force_delay_s", force_delay_s, "must be in [0, 0.05]");
+  if (!(load_friction_gain >= 0.0 && load_friction_gain <= 10.0)) bad("load_friction_gain", load_friction_gain, "must be in [0, 10]");
+  if (!(load_friction_reference_kN > 0.0)) bad("load_friction_reference_kN", load_friction_reference_kN, "must be > 0");
+  if (!(backlash_width_rev >= 0.0 && backlash_width_rev <= 0.5)) bad("backlash_width_rev", backlash_width_rev, "must be in [0, 0.5]");
   if (!(k_smoothing > 0.0 && k_smoothing <= 1.0)) bad("k_smoothing", k_smoothing, "must be in (0, 1]");
 }
 

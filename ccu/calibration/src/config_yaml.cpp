@@ -66,6 +66,10 @@ CalibratorConfig read_config(Reader& r) {
         fx->number_or("viscous_speed_scale_rev_per_s", c.viscous_speed_scale_rev_per_s, Range::positive());
     c.velocity_window = static_cast<int>(fx->integer_or("velocity_window", c.velocity_window, 2, 1000));
     c.force_delay_s = fx->number_or("force_delay_s", c.force_delay_s, Range::closed(0.0, 0.05));
+    c.load_friction_gain = fx->number_or("load_friction_gain", c.load_friction_gain, Range::closed(0.0, 10.0));
+    c.load_friction_reference_kN =
+        fx->number_or("load_friction_reference_kN", c.load_friction_reference_kN, Range::positive());
+    c.backlash_width_rev = fx->number_or("backlash_width_rev", c.backlash_width_rev, Range::closed(0.0, 0.5));
     fx->finish();
   }
   try {

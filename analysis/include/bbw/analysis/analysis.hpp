@@ -108,8 +108,11 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options);
 
 // The online calibrator's optional effect terms (its config's `effects:` keys,
 // docs/calibrator.md) that the accepted steps call for: viscous_friction -> viscous_friction = 1
-// (on; the calibrator fits c_v itself), sensor_delay -> force_delay_s = the measured delay.
-// Effects without an online term give none.
+// (on; the calibrator fits c_v itself), sensor_delay -> force_delay_s = the measured delay,
+// backlash -> backlash_width_rev = the measured width, load_dependent_friction ->
+// load_friction_gain (clamped to the calibrator's [0, 10]) and load_friction_reference_kN (the
+// force that gain applies at). Effects without an online term (temperature drift, creep,
+// inertia, recorded channels) give none.
 struct CalibratorTerm {
   std::string key;
   double value = 0.0;

@@ -119,6 +119,10 @@ class Calibrator {
   common::DelayLine position_delay_;     // positions for the force-delay term (2 slots when off)
   std::size_t vel_head_ = 0, vel_count_ = 0;
   double speed_now(const Sample& s);
+  // Load-dependent friction: the factor on the element regressors at x (1 when off).
+  double load_scale(double x_rev) const;
+  // Backlash: the spindle position (play operator of the resolver position; state below).
+  double spindle_rev_ = 0.0;
   std::vector<double> start_pos_rev_;    // x0_i at the current cycle's start (replay)
 
   // Fit workspace, sized at construction.

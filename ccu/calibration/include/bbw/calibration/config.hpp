@@ -65,6 +65,18 @@ struct CalibratorConfig {
   //   f_hat(t) = f_c(t) - friction(x(t - d)) + C(x(t)) - C(x(t - d)).
   double force_delay_s = 0.0;
   static constexpr std::size_t kForceDelayCapacity = 128;
+  // load_friction_gain: the key friction grows with the clamp force (./bbw analyze's
+  // load_dependent_friction: friction_gain_at_full_curve at its reference_force):
+  //   friction = sum_i K_i Delta_i n_i * (1 + g max(C(x), 0) / F_ref),
+  // with C the current curve. The element regressors are scaled by that factor and K_i fitted
+  // as before. 0 = off; at most 10.
+  double load_friction_gain = 0.0;
+  double load_friction_reference_kN = 40.0;
+  // backlash_width_rev: play between the resolver (motor side) and the spindle that loads the
+  // pads (./bbw analyze's backlash.width). The model runs on the spindle position, the play
+  // operator of the resolver position: inside the gap the spindle stays where it was. 0 = off;
+  // at most 0.5.
+  double backlash_width_rev = 0.0;
 
   // Throws std::invalid_argument naming the field, its value and the rule.
   void validate() const;
