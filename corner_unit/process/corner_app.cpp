@@ -161,13 +161,13 @@ void CornerApp::drain_inputs() {
   msg::CalibrationState state;
   while (calibration_.take(state)) {
     if (state.corner_id() != my_id_) continue;
-    if (state.version() < model_.version && elements_initialised_) continue;  // stale
+    if (state.version() < model_.version && friction_.started()) continue;  // stale
     dds::CalibrationModel m;
     if (!dds::from_msg(state, m)) {
       ++stats_.calibrations_rejected;
       continue;
     }
-    if (!model_.delta_rev.empty() && m.delta_rev != model_.delta_rev) {
+    if (!model_.friction.delta_rev.empty() && m.friction.delta_rev != model_.friction.delta_rev) {
       ++stats_.calibrations_rejected;  // thresholds are fixed by the calibrator config
       continue;
     }
@@ -206,17 +206,14 @@ void CornerApp::simulate_period(std::uint64_t k) {
     if (w.force_command_kN) ext.force_command_kN = w.force_command_kN;
     if (w.mode == faults::WatchdogMode::Holding && stats_.ccu_lost_s < 0.0) stats_.ccu_lost_s = t_end;
     if (w.mode == faults::WatchdogMode::Default && stats_.default_force_s < 0.0) stats_.default_force_s = t_end;
-    // Friction the load cell is believed to hold, from the CCU's Maxwell-slip model and this
-    // corner's own element states (they depend only on the position history).
+    // Friction the load cell is believed to hold, from the CCU's model (Maxwell-slip elements
+    // and the calibrator's optional effect terms) and this corner's own element and play states
+    // (they depend only on the position history).
     const double x = sim_.last().position_rev;
     double friction = 0.0;
-    if (!model_.delta_rev.empty()) {
-      if (!elements_initialised_) {
-        element_pos_rev_.assign(model_.delta_rev.size(), x);
-        elements_initialised_ = true;
-      }
-      friction = calibration::elements_step(x, model_.delta_rev.data(), element_pos_rev_.data(),
-                                            model_.delta_rev.size(), model_.stiffness_kN_per_rev.data(), nullptr);
+    if (!model_.friction.delta_rev.empty()) {
+      if (!friction_.started()) friction_.reset(model_.friction.delta_rev.size(), x);
+      friction = friction_.step(model_.friction, x, sim_.last().speed_rev_s);
     }
     ext.friction_estimate_kN = calibrated ? friction : 0.0;
     injector_.prepare(ext, t_end);

@@ -142,8 +142,7 @@ class CornerApp {
   bool have_command_ = false;
   std::optional<std::uint64_t> last_command_seq_;
   dds::CalibrationModel model_;
-  std::vector<double> element_pos_rev_;
-  bool elements_initialised_ = false;
+  calibration::FrictionTracker friction_;  // element and play states of the CCU's friction model
   CornerStats stats_;
 };
 

@@ -52,6 +52,10 @@ void to_msg(const calibration::Calibrator& calibrator, std::uint8_t corner_id, s
   out.curve_d_kN(c.d);
   out.friction_delta_rev(f.delta_rev);
   out.friction_stiffness_kN_per_rev(f.stiffness_kN_per_rev);
+  out.friction_viscous_kN_per_rev_per_s(calibrator.config().viscous_friction ? f.viscous_kN_per_rev_per_s : 0.0);
+  out.friction_load_gain(calibrator.config().load_friction_gain);
+  out.friction_load_reference_kN(calibrator.config().load_friction_reference_kN);
+  out.backlash_width_rev(calibrator.config().backlash_width_rev);
   out.fits_accepted(st.fits_accepted);
   out.fits_rejected(st.fits_rejected);
   out.cycles_detected(st.cycles_detected);
@@ -69,9 +73,25 @@ bool from_msg(const msg::CalibrationState& in, CalibrationModel& out) {
   for (std::size_t i = 0; i < d.size(); ++i) {
     if (!std::isfinite(d[i]) || !(d[i] > 0.0) || !std::isfinite(k[i])) return false;
   }
+  // The effect terms within the calibrator config's own bounds (config.cpp).
+  if (!(in.friction_viscous_kN_per_rev_per_s() >= 0.0 && std::isfinite(in.friction_viscous_kN_per_rev_per_s())) ||
+      !(in.friction_load_gain() >= 0.0 && in.friction_load_gain() <= 10.0) ||
+      !(in.friction_load_reference_kN() > 0.0 && std::isfinite(in.friction_load_reference_kN())) ||
+      !(in.backlash_width_rev() >= 0.0 && in.backlash_width_rev() <= 0.5)) {
+    return false;
+  }
   out.curve = {in.curve_a_kN_per_rev3(), in.curve_b_kN_per_rev2(), in.curve_c_kN_per_rev(), in.curve_d_kN()};
-  out.delta_rev.assign(d.begin(), d.end());
-  out.stiffness_kN_per_rev.assign(k.begin(), k.end());
+  auto& f = out.friction;
+  f.delta_rev.assign(d.begin(), d.end());
+  f.stiffness_kN_per_rev.assign(k.begin(), k.end());
+  f.viscous_kN_per_rev_per_s = in.friction_viscous_kN_per_rev_per_s();
+  f.load_gain = in.friction_load_gain();
+  f.load_reference_kN = in.friction_load_reference_kN();
+  f.backlash_width_rev = in.backlash_width_rev();
+  f.curve_a = out.curve.a;
+  f.curve_b = out.curve.b;
+  f.curve_c = out.curve.c;
+  f.curve_d = out.curve.d;
   out.version = in.version();
   return true;
 }

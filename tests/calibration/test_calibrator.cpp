@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "bbw/calibration/calibrator.hpp"
+#include "bbw/calibration/friction_tracker.hpp"
 #include "bbw/calibration/offline.hpp"
 #include "synthetic.hpp"
 
@@ -183,4 +184,44 @@ TEST(Calibrator, LoadFrictionTermScalesTheFrictionWithTheCurveForce) {
     checked += std::fabs(a.friction_kN) > 0.1 ? 1 : 0;
   }
   EXPECT_GT(checked, 100);  // the friction was not zero throughout
+}
+
+// A corner replays the CCU's friction model with FrictionTracker: with the same parameters and
+// the same position history it gives the calibrator's own friction estimate (no fit happens
+// here: one minimum, so no cycle ends).
+TEST(FrictionTracker, GivesTheCalibratorsFrictionEstimate) {
+  auto c = base_config(Mode::Robust);
+  c.initial_curve = Curve{0.0, 0.5, 4.0, -3.0};
+  c.backlash_width_rev = 0.04;
+  c.load_friction_gain = 0.7;
+  c.load_friction_reference_kN = 30.0;
+  Calibrator cal(c);
+  std::vector<double> k;
+  for (double d : cal.friction().delta_rev) k.push_back(0.2 / d);
+  cal.set_friction_stiffness(k);
+  FrictionModel m;
+  m.delta_rev = cal.friction().delta_rev;
+  m.stiffness_kN_per_rev = k;
+  m.load_gain = 0.7;
+  m.load_reference_kN = 30.0;
+  m.backlash_width_rev = 0.04;
+  m.curve_a = 0.0;
+  m.curve_b = 0.5;
+  m.curve_c = 4.0;
+  m.curve_d = -3.0;
+  FrictionTracker tracker;
+  double max_friction = 0.0;
+  for (int j = 0; j < 3000; ++j) {
+    // up 1 -> 3 rev, down to 2, up to 2.5, with a small ripple that stays inside the play
+    const double t = 0.001 * j;
+    const double x = (j < 1000 ? 1.0 + 2.0 * t : j < 2000 ? 3.0 - (t - 1.0) : 2.0 + 0.5 * (t - 2.0)) +
+                     0.01 * std::sin(40.0 * t);
+    if (!tracker.started()) tracker.reset(m.delta_rev.size(), x);
+    const Estimate e = cal.update({t + 0.001, x, 10.0});
+    ASSERT_TRUE(e.valid);
+    EXPECT_NEAR(tracker.step(m, x, 0.0), e.friction_kN, 1e-12) << "sample " << j;
+    max_friction = std::max(max_friction, std::fabs(e.friction_kN));
+  }
+  EXPECT_EQ(cal.stats().fits_accepted + cal.stats().fits_rejected, 0u);
+  EXPECT_GT(max_friction, 0.5);  // the elements did slip and load: the comparison means something
 }

@@ -330,7 +330,7 @@ void Calibrator::refit_curve_from_pf() {
 
 double Calibrator::load_scale(double x_rev) const {
   if (config_.load_friction_gain <= 0.0) return 1.0;
-  return 1.0 + config_.load_friction_gain * std::max(curve_.force_kN(x_rev), 0.0) / config_.load_friction_reference_kN;
+  return load_friction_scale(config_.load_friction_gain, config_.load_friction_reference_kN, curve_.force_kN(x_rev));
 }
 
 // Resolver speed when the sample carries one; else the least-squares slope of the last
@@ -384,11 +384,10 @@ Estimate Calibrator::update(const Sample& s) {
   if (config_.backlash_width_rev > 0.0) {
     // The model runs on the spindle position; with a delay too, the play acts on the delayed
     // position and the present spindle is the play state pulled along to the present position.
-    const double half = 0.5 * config_.backlash_width_rev;
     if (!have_time_) spindle_rev_ = x;
-    spindle_rev_ = std::clamp(spindle_rev_, x - half, x + half);
-    x = spindle_rev_;
-    x_now = delayed ? std::clamp(spindle_rev_, s.position_rev - half, s.position_rev + half) : x;
+    x = play_step(spindle_rev_, x, config_.backlash_width_rev);
+    double pulled = spindle_rev_;
+    x_now = delayed ? play_step(pulled, s.position_rev, config_.backlash_width_rev) : x;
   }
   if (!have_time_) {
     first_x_rev_ = x;

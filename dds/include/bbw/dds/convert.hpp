@@ -5,6 +5,7 @@
 #include <bbw/idl/bbw_msgs.h>
 
 #include "bbw/calibration/calibrator.hpp"
+#include "bbw/calibration/friction_tracker.hpp"
 #include "bbw/scenario/corner_sim.hpp"
 
 namespace bbw::dds {
@@ -26,8 +27,7 @@ void to_msg(const calibration::Calibrator& calibrator, std::uint8_t corner_id, s
 // message is malformed (sizes differ, non-finite numbers, negative thresholds).
 struct CalibrationModel {
   scenario::CurveEstimate curve;
-  std::vector<double> delta_rev;
-  std::vector<double> stiffness_kN_per_rev;
+  calibration::FrictionModel friction;  // the curve's coefficients too (load-dependent term)
   std::uint64_t version = 0;
 };
 bool from_msg(const msg::CalibrationState& in, CalibrationModel& out);

@@ -24,6 +24,21 @@ inline double element_step(double x_rev, double delta_rev, double& pos_rev) {
   return d / delta_rev;
 }
 
+// Backlash: one step of the play operator. `spindle_rev` (the state) is dragged along so that it
+// stays within half the play of the resolver position; returns it.
+inline double play_step(double& spindle_rev, double x_rev, double width_rev) {
+  const double half = 0.5 * width_rev;
+  if (spindle_rev < x_rev - half) spindle_rev = x_rev - half;
+  if (spindle_rev > x_rev + half) spindle_rev = x_rev + half;
+  return spindle_rev;
+}
+
+// Load-dependent key friction: the factor 1 + g max(F, 0) / F_ref on the Maxwell-slip friction
+// at clamp force F (kN).
+inline double load_friction_scale(double gain, double reference_kN, double force_kN) {
+  return 1.0 + gain * (force_kN > 0.0 ? force_kN : 0.0) / reference_kN;
+}
+
 // Steps all M elements at x; writes n_i into n_out (may be null). Returns sum K_i Delta_i n_i
 // when k is non-null, else 0.
 inline double elements_step(double x_rev, const double* delta_rev, double* pos_rev, std::size_t m,

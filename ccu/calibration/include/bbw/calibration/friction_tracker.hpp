@@ -1,0 +1,53 @@
+// The calibrator's friction model replayed elsewhere (a corner's friction-compensated load-cell
+// feedback, docs/distributed.md): Maxwell-slip elements with the published thresholds and
+// stiffnesses, plus the optional effect terms (backlash play, load-dependent scaling along the
+// published curve, viscous term), with its own element and play states. The same arithmetic as
+// Calibrator::update's friction estimate (tested against it). Allocates only in reset().
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "bbw/calibration/maxwell_slip.hpp"
+
+namespace bbw::calibration {
+
+struct FrictionModel {
+  std::vector<double> delta_rev;             // thresholds Delta_i
+  std::vector<double> stiffness_kN_per_rev;  // K_i
+  double viscous_kN_per_rev_per_s = 0.0;     // c_v (0 = off)
+  double load_gain = 0.0;                    // g (0 = off)
+  double load_reference_kN = 40.0;
+  double backlash_width_rev = 0.0;           // 0 = off
+  double curve_a = 0.0, curve_b = 0.0, curve_c = 0.0, curve_d = 0.0;  // F(x), kN
+};
+
+class FrictionTracker {
+ public:
+  // States start at x_rev (every element and the spindle at rest there).
+  void reset(std::size_t elements, double x_rev) {
+    pos_rev_.assign(elements, x_rev);
+    spindle_rev_ = x_rev;
+    started_ = true;
+  }
+  bool started() const { return started_; }
+  // Friction (kN) the load cell holds at resolver position x and speed v; the model's sizes
+  // must match reset()'s.
+  double step(const FrictionModel& m, double x_rev, double speed_rev_s) {
+    const double x = m.backlash_width_rev > 0.0 ? play_step(spindle_rev_, x_rev, m.backlash_width_rev) : x_rev;
+    double f = elements_step(x, m.delta_rev.data(), pos_rev_.data(), pos_rev_.size(), m.stiffness_kN_per_rev.data(),
+                             nullptr);
+    if (m.load_gain > 0.0) {
+      const double curve_kN = ((m.curve_a * x + m.curve_b) * x + m.curve_c) * x + m.curve_d;
+      f *= load_friction_scale(m.load_gain, m.load_reference_kN, curve_kN);
+    }
+    return f + m.viscous_kN_per_rev_per_s * speed_rev_s;
+  }
+
+ private:
+  std::vector<double> pos_rev_;
+  double spindle_rev_ = 0.0;
+  bool started_ = false;
+};
+
+}  // namespace bbw::calibration
