@@ -744,6 +744,12 @@ std::vector<CalibratorTerm> calibrator_terms(const AnalysisResult& r) {
         }
         if (p.name == "load_dependent_friction.reference_force") out.push_back({"load_friction_reference_kN", p.value});
       }
+      if (s.evidence.name == "temperature_drift") {
+        if (p.name == "temperature_drift.sensor_offset_per_degC") {
+          out.push_back({"load_cell_offset_kN_per_C", std::clamp(p.value, -1.0, 1.0)});
+        }
+        if (p.name == "temperature_drift.reference_temperature_C") out.push_back({"load_cell_offset_reference_C", p.value});
+      }
     }
   }
   return out;

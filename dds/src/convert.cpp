@@ -56,6 +56,8 @@ void to_msg(const calibration::Calibrator& calibrator, std::uint8_t corner_id, s
   out.friction_load_gain(calibrator.config().load_friction_gain);
   out.friction_load_reference_kN(calibrator.config().load_friction_reference_kN);
   out.backlash_width_rev(calibrator.config().backlash_width_rev);
+  out.load_cell_offset_kN_per_C(calibrator.config().load_cell_offset_kN_per_C);
+  out.load_cell_offset_reference_C(calibrator.config().load_cell_offset_reference_C);
   out.fits_accepted(st.fits_accepted);
   out.fits_rejected(st.fits_rejected);
   out.cycles_detected(st.cycles_detected);
@@ -77,7 +79,9 @@ bool from_msg(const msg::CalibrationState& in, CalibrationModel& out) {
   if (!(in.friction_viscous_kN_per_rev_per_s() >= 0.0 && std::isfinite(in.friction_viscous_kN_per_rev_per_s())) ||
       !(in.friction_load_gain() >= 0.0 && in.friction_load_gain() <= 10.0) ||
       !(in.friction_load_reference_kN() > 0.0 && std::isfinite(in.friction_load_reference_kN())) ||
-      !(in.backlash_width_rev() >= 0.0 && in.backlash_width_rev() <= 0.5)) {
+      !(in.backlash_width_rev() >= 0.0 && in.backlash_width_rev() <= 0.5) ||
+      !(in.load_cell_offset_kN_per_C() >= -1.0 && in.load_cell_offset_kN_per_C() <= 1.0) ||
+      !(in.load_cell_offset_reference_C() >= -50.0 && in.load_cell_offset_reference_C() <= 150.0)) {
     return false;
   }
   out.curve = {in.curve_a_kN_per_rev3(), in.curve_b_kN_per_rev2(), in.curve_c_kN_per_rev(), in.curve_d_kN()};
@@ -88,6 +92,8 @@ bool from_msg(const msg::CalibrationState& in, CalibrationModel& out) {
   f.load_gain = in.friction_load_gain();
   f.load_reference_kN = in.friction_load_reference_kN();
   f.backlash_width_rev = in.backlash_width_rev();
+  f.load_cell_offset_kN_per_C = in.load_cell_offset_kN_per_C();
+  f.load_cell_offset_reference_C = in.load_cell_offset_reference_C();
   f.curve_a = out.curve.a;
   f.curve_b = out.curve.b;
   f.curve_c = out.curve.c;

@@ -113,7 +113,7 @@ INSTANTIATE_TEST_SUITE_P(PaperRig, PlantEffect,
 class OnlineTerm : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(OnlineTerm, WhatTheAnalysisFindsSwitchedOnInTheCalibratorHalvesItsError) {
-  const analysis::Recording rec = record({GetParam()});
+  const analysis::Recording rec = record({GetParam() == "temperature_drift" ? "thermal_drift" : GetParam()});
   const auto r = analysis::analyze(rec, analysis::AnalysisOptions{});
   ASSERT_FALSE(r.steps.empty()) << describe(r);
   ASSERT_EQ(r.steps[0].evidence.name, GetParam()) << describe(r);
@@ -140,12 +140,17 @@ TEST_P(OnlineTerm, WhatTheAnalysisFindsSwitchedOnInTheCalibratorHalvesItsError) 
     EXPECT_NEAR(t.at("load_friction_gain") / t.at("load_friction_reference_kN"), 1.0 / 40.0, 0.25 / 40.0) << said;
     on.load_friction_gain = t.at("load_friction_gain");
     on.load_friction_reference_kN = t.at("load_friction_reference_kN");
+  } else if (GetParam() == "temperature_drift") {
+    ASSERT_EQ(t.size(), 2u) << said;
+    EXPECT_NEAR(t.at("load_cell_offset_kN_per_C"), 0.02, 0.002) << said;  // the plant's drift
+    on.load_cell_offset_kN_per_C = t.at("load_cell_offset_kN_per_C");
+    on.load_cell_offset_reference_C = t.at("load_cell_offset_reference_C");
   } else {
     ASSERT_EQ(t.size(), 1u) << said;
     EXPECT_EQ(t.count("viscous_friction"), 1u);
     on.viscous_friction = true;
   }
-  calibration::Recording online{rec.time_s, rec.position, rec.force, rec.truth, rec.velocity};
+  calibration::Recording online{rec.time_s, rec.position, rec.force, rec.truth, rec.velocity, rec.temperature};
   const auto before = calibration::run_recording(off, online);
   const auto after = calibration::run_recording(on, online);
   std::printf("%s: online worst case %.3f -> %.3f kN, RMS %.3f -> %.3f kN with%s\n", GetParam().c_str(),
@@ -155,7 +160,8 @@ TEST_P(OnlineTerm, WhatTheAnalysisFindsSwitchedOnInTheCalibratorHalvesItsError) 
 }
 
 INSTANTIATE_TEST_SUITE_P(PaperRig, OnlineTerm,
-                         ::testing::Values("viscous_friction", "sensor_delay", "backlash", "load_dependent_friction"));
+                         ::testing::Values("viscous_friction", "sensor_delay", "backlash", "load_dependent_friction",
+                                           "temperature_drift"));
 
 TEST(PlantNoEffect, AddsNothingAndReportsNoStructure) {
   const auto r = analysis::analyze(record({}), analysis::AnalysisOptions{});

@@ -187,14 +187,16 @@ TEST(Calibrator, LoadFrictionTermScalesTheFrictionWithTheCurveForce) {
 }
 
 // A corner replays the CCU's friction model with FrictionTracker: with the same parameters and
-// the same position history it gives the calibrator's own friction estimate (no fit happens
-// here: one minimum, so no cycle ends).
+// the same position and temperature history it gives the calibrator's own estimate (no fit
+// happens here: one minimum, so no cycle ends).
 TEST(FrictionTracker, GivesTheCalibratorsFrictionEstimate) {
   auto c = base_config(Mode::Robust);
   c.initial_curve = Curve{0.0, 0.5, 4.0, -3.0};
   c.backlash_width_rev = 0.04;
   c.load_friction_gain = 0.7;
   c.load_friction_reference_kN = 30.0;
+  c.load_cell_offset_kN_per_C = -0.03;
+  c.load_cell_offset_reference_C = 35.0;
   Calibrator cal(c);
   std::vector<double> k;
   for (double d : cal.friction().delta_rev) k.push_back(0.2 / d);
@@ -209,6 +211,8 @@ TEST(FrictionTracker, GivesTheCalibratorsFrictionEstimate) {
   m.curve_b = 0.5;
   m.curve_c = 4.0;
   m.curve_d = -3.0;
+  m.load_cell_offset_kN_per_C = -0.03;
+  m.load_cell_offset_reference_C = 35.0;
   FrictionTracker tracker;
   double max_friction = 0.0;
   for (int j = 0; j < 3000; ++j) {
@@ -217,11 +221,31 @@ TEST(FrictionTracker, GivesTheCalibratorsFrictionEstimate) {
     const double x = (j < 1000 ? 1.0 + 2.0 * t : j < 2000 ? 3.0 - (t - 1.0) : 2.0 + 0.5 * (t - 2.0)) +
                      0.01 * std::sin(40.0 * t);
     if (!tracker.started()) tracker.reset(m.delta_rev.size(), x);
-    const Estimate e = cal.update({t + 0.001, x, 10.0});
+    // Temperature from 30 to 60 C, missing on every 7th sample.
+    const double temp_C = j % 7 == 3 ? std::nan("") : 30.0 + 0.01 * j;
+    const Estimate e = cal.update({t + 0.001, x, 10.0, std::nan(""), temp_C});
     ASSERT_TRUE(e.valid);
-    EXPECT_NEAR(tracker.step(m, x, 0.0), e.friction_kN, 1e-12) << "sample " << j;
+    // The load cell minus what the tracker says it holds beyond the clamp force is f_hat.
+    EXPECT_NEAR(10.0 - tracker.step_load_cell_excess(m, x, 0.0, temp_C), e.force_kN, 1e-12) << "sample " << j;
     max_friction = std::max(max_friction, std::fabs(e.friction_kN));
   }
   EXPECT_EQ(cal.stats().fits_accepted + cal.stats().fits_rejected, 0u);
   EXPECT_GT(max_friction, 0.5);  // the elements did slip and load: the comparison means something
+}
+
+// Load-cell thermal offset term: k (T - T_ref) comes off every reading before the model; a
+// sample without a temperature uses the last one (the reference before any).
+TEST(Calibrator, LoadCellOffsetTermRemovesTheThermalZeroDrift) {
+  auto c = base_config(Mode::Robust);
+  c.load_cell_offset_kN_per_C = 0.02;
+  c.load_cell_offset_reference_C = 40.0;
+  Calibrator cal(c);
+  const double nan = std::nan("");
+  EXPECT_NEAR(cal.update({0.001, 1.0, 10.0, nan, nan}).force_kN, 10.0, 1e-12);   // none yet: T_ref
+  EXPECT_NEAR(cal.update({0.002, 1.0, 10.0, nan, 50.0}).force_kN, 9.8, 1e-12);   // 0.02 x 10 C
+  EXPECT_NEAR(cal.update({0.003, 1.0, 10.0, nan, nan}).force_kN, 9.8, 1e-12);    // the last one
+  EXPECT_NEAR(cal.update({0.004, 1.0, 10.0, nan, 30.0}).force_kN, 10.2, 1e-12);  // below T_ref
+  c.load_cell_offset_kN_per_C = 0.0;
+  Calibrator plain(c);
+  EXPECT_NEAR(plain.update({0.001, 1.0, 10.0, nan, 50.0}).force_kN, 10.0, 1e-12);  // off
 }

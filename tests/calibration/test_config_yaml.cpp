@@ -146,7 +146,8 @@ TEST(CalibratorConfigYaml, BacklashAndLoadFrictionTermsLoadAndAreBounded) {
     const char* rule_part;
   };
   for (const Case& k : {Case{"backlash_width_rev", "0.6", "0.5"}, Case{"load_friction_gain", "-0.1", "0"},
-                        Case{"load_friction_gain", "11", "10"}, Case{"load_friction_reference_kN", "0", ">"}}) {
+                        Case{"load_friction_gain", "11", "10"}, Case{"load_friction_reference_kN", "0", ">"},
+                        Case{"load_cell_offset_kN_per_C", "1.5", "1"}, Case{"load_cell_offset_reference_C", "200", "150"}}) {
     const std::string text = robust_text() + "effects:\n  " + k.key + ": " + k.value + "\n";
     const auto e = load_broken(text);
     EXPECT_EQ(e.key_path(), std::string("effects.") + k.key);

@@ -13,7 +13,7 @@ using namespace bbw::calibration;
 
 TEST(CalibratorAllocation, NoHeapAllocationPerSample) {
   // Both modes, and robust mode with every optional effect term (viscous, force delay,
-  // backlash, load-dependent friction) on.
+  // backlash, load-dependent friction, load-cell thermal offset) on.
   for (int variant = 0; variant < 3; ++variant) {
     const Mode mode = variant == 1 ? Mode::Paper : Mode::Robust;
     CalibratorConfig c;
@@ -23,6 +23,7 @@ TEST(CalibratorAllocation, NoHeapAllocationPerSample) {
       c.force_delay_s = 0.005;
       c.backlash_width_rev = 0.02;
       c.load_friction_gain = 0.5;
+      c.load_cell_offset_kN_per_C = 0.01;
     }
     c.elements_M = 8;
     c.samples_L = 64;

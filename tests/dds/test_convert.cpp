@@ -15,6 +15,8 @@ calibration::CalibratorConfig config_with_terms() {
   c.load_friction_gain = 0.9;
   c.load_friction_reference_kN = 35.7;
   c.backlash_width_rev = 0.042;
+  c.load_cell_offset_kN_per_C = 0.02;
+  c.load_cell_offset_reference_C = 38.0;
   return c;
 }
 
@@ -32,6 +34,8 @@ TEST(CalibrationStateConvert, CarriesTheEffectTermsToTheCorner) {
   EXPECT_DOUBLE_EQ(m.friction.load_gain, 0.9);
   EXPECT_DOUBLE_EQ(m.friction.load_reference_kN, 35.7);
   EXPECT_DOUBLE_EQ(m.friction.backlash_width_rev, 0.042);
+  EXPECT_DOUBLE_EQ(m.friction.load_cell_offset_kN_per_C, 0.02);
+  EXPECT_DOUBLE_EQ(m.friction.load_cell_offset_reference_C, 38.0);
 }
 
 TEST(CalibrationStateConvert, TermsOffAreZero) {
@@ -65,6 +69,8 @@ TEST(CalibrationStateConvert, RefusesTermsOutOfTheirBounds) {
   EXPECT_TRUE(refused([](msg::CalibrationState& s) { s.friction_load_gain(11.0); }));
   EXPECT_TRUE(refused([](msg::CalibrationState& s) { s.friction_load_reference_kN(0.0); }));
   EXPECT_TRUE(refused([](msg::CalibrationState& s) { s.backlash_width_rev(0.6); }));
+  EXPECT_TRUE(refused([](msg::CalibrationState& s) { s.load_cell_offset_kN_per_C(2.0); }));
+  EXPECT_TRUE(refused([](msg::CalibrationState& s) { s.load_cell_offset_reference_C(std::nan("")); }));
   EXPECT_FALSE(refused([](msg::CalibrationState&) {}));
 }
 

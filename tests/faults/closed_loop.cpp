@@ -38,6 +38,7 @@ CornerReading reading_from(const scenario::CornerSample& s, std::uint64_t seq_of
   r.speed_rev_per_s = s.speed_rev_s;
   r.load_cell_kN = s.force_internal_kN;
   r.motor_current_A = s.motor_current_A;
+  r.temperature_C = s.temperature_C;
   r.force_command_kN =
       s.command_kind == scenario::CommandKind::Force ? s.command : std::numeric_limits<double>::quiet_NaN();
   return r;

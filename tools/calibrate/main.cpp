@@ -16,14 +16,15 @@ namespace {
 const char* kUsage =
     "usage: bbw_calibrate --input FILE.csv [--config FILE.yaml] --out DIR\n"
     "                     [--time COL] [--position COL] [--force COL] [--truth COL] [--speed COL]\n"
+    "                     [--temperature COL]\n"
     "  Runs the calibrator over a recording. Default columns: time_s, position_rev,\n"
-    "  force_internal_kN; truth: force_external_kN and speed: speed_rev_s when present.\n";
+    "  force_internal_kN; truth: force_external_kN, speed: speed_rev_s and temperature: temperature_C when present.\n";
 
 struct Args {
   std::string input, config = BBW_DEFAULT_CALIBRATOR_CONFIG, out;
   std::string time_col = "time_s", position_col = "position_rev", force_col = "force_internal_kN";
-  std::string truth_col, speed_col;
-  bool truth_given = false, speed_given = false;
+  std::string truth_col, speed_col, temperature_col;
+  bool truth_given = false, speed_given = false, temperature_given = false;
 };
 
 bool parse(int argc, char** argv, Args& a) {
@@ -41,6 +42,7 @@ bool parse(int argc, char** argv, Args& a) {
     else if (k == "--force") next(a.force_col);
     else if (k == "--truth") { next(a.truth_col); a.truth_given = true; }
     else if (k == "--speed") { next(a.speed_col); a.speed_given = true; }
+    else if (k == "--temperature") { next(a.temperature_col); a.temperature_given = true; }
     else if (k == "-h" || k == "--help") { std::cout << kUsage; std::exit(0); }
     else throw std::invalid_argument("unknown argument '" + k + "'");
   }
@@ -90,6 +92,8 @@ int main(int argc, char** argv) {
     else ro.optional.push_back("force_external_kN");
     if (a.speed_given) ro.required.push_back(a.speed_col);
     else ro.optional.push_back("speed_rev_s");
+    if (a.temperature_given) ro.required.push_back(a.temperature_col);
+    else ro.optional.push_back("temperature_C");
     const auto table = bbw::csv::read(a.input, ro);
     if (table.lines_rejected > 0) std::cerr << "bbw_calibrate: " << a.input << ": " << table.rejection_summary() << "\n";
     const std::string truth_col = a.truth_given ? a.truth_col : (table.has("force_external_kN") ? "force_external_kN" : "");
@@ -101,6 +105,9 @@ int main(int argc, char** argv) {
     if (!truth_col.empty()) rec.truth_kN = table.column(truth_col);
     const std::string speed_col = a.speed_given ? a.speed_col : (table.has("speed_rev_s") ? "speed_rev_s" : "");
     if (!speed_col.empty()) rec.speed_rev_s = table.column(speed_col);
+    const std::string temp_col =
+        a.temperature_given ? a.temperature_col : (table.has("temperature_C") ? "temperature_C" : "");
+    if (!temp_col.empty()) rec.temperature_C = table.column(temp_col);
     const auto res = bbw::calibration::run_recording(config, rec);
 
     std::error_code ec;

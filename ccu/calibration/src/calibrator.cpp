@@ -116,6 +116,7 @@ Calibrator::Calibrator(const CalibratorConfig& config)
   for (std::size_t k = 0; k < n_pf; ++k) pf_f_kN_[k] = curve_.force_kN(pf_x_rev_[k]);
 
   element_pos_rev_.assign(m, 0.0);
+  temperature_C_ = config.load_cell_offset_reference_C;
   n_now_.assign(m + static_cast<std::size_t>(e_), 0.0);
   if (e_ > 0) {
     vel_t_s_.assign(static_cast<std::size_t>(config.velocity_window), 0.0);
@@ -374,6 +375,12 @@ Estimate Calibrator::update(const Sample& s) {
     e.calibrated = stats_.fits_accepted > 0;
     return e;
   }
+  // The load cell's thermal offset removed first: the model never sees it.
+  double f_c = s.force_kN;
+  if (config_.load_cell_offset_kN_per_C != 0.0) {
+    if (std::isfinite(s.temperature_C)) temperature_C_ = s.temperature_C;
+    f_c -= load_cell_offset_kN(config_.load_cell_offset_kN_per_C, config_.load_cell_offset_reference_C, temperature_C_);
+  }
   // With a force delay d the load cell at t belongs to the position at t - d: the model runs
   // on that position and the estimate is carried to the present along the curve.
   const bool delayed = config_.force_delay_s > 0.0;
@@ -422,21 +429,21 @@ Estimate Calibrator::update(const Sample& s) {
   }
   if (e_ > 0) {
     // Delayed: the speed is the slope of the delayed positions (the sample's speed is current).
-    const Sample at_x{s.time_s, x, s.force_kN, delayed ? std::numeric_limits<double>::quiet_NaN() : s.speed_rev_s};
+    const Sample at_x{s.time_s, x, f_c, delayed ? std::numeric_limits<double>::quiet_NaN() : s.speed_rev_s};
     n_now_[static_cast<std::size_t>(m_)] = speed_now(at_x) / config_.viscous_speed_scale_rev_per_s;
   }
   double f_fric = 0.0;
   for (int i = 0; i < m_ + e_; ++i) f_fric += phi_kN_[static_cast<std::size_t>(i)] * n_now_[static_cast<std::size_t>(i)];
 
   if (in_cycle_) {
-    store_.add(x, s.force_kN, n_now_.data());
+    store_.add(x, f_c, n_now_.data());
     ++samples_since_start_;
   }
 
   e.valid = true;
   e.friction_kN = f_fric;
   e.curve_force_kN = curve_.force_kN(x_now);
-  e.force_kN = s.force_kN - f_fric;
+  e.force_kN = f_c - f_fric;
   if (delayed) e.force_kN += e.curve_force_kN - curve_.force_kN(x);
   e.calibrated = stats_.fits_accepted > 0;
   return e;

@@ -48,6 +48,8 @@ void CalibratorConfig::validate() const {
   if (!(load_friction_gain >= 0.0 && load_friction_gain <= 10.0)) bad("load_friction_gain", load_friction_gain, "must be in [0, 10]");
   if (!(load_friction_reference_kN > 0.0)) bad("load_friction_reference_kN", load_friction_reference_kN, "must be > 0");
   if (!(backlash_width_rev >= 0.0 && backlash_width_rev <= 0.5)) bad("backlash_width_rev", backlash_width_rev, "must be in [0, 0.5]");
+  if (!(load_cell_offset_kN_per_C >= -1.0 && load_cell_offset_kN_per_C <= 1.0)) bad("load_cell_offset_kN_per_C", load_cell_offset_kN_per_C, "must be in [-1, 1]");
+  if (!(load_cell_offset_reference_C >= -50.0 && load_cell_offset_reference_C <= 150.0)) bad("load_cell_offset_reference_C", load_cell_offset_reference_C, "must be in [-50, 150]");
   if (!(k_smoothing > 0.0 && k_smoothing <= 1.0)) bad("k_smoothing", k_smoothing, "must be in (0, 1]");
 }
 

@@ -70,6 +70,10 @@ CalibratorConfig read_config(Reader& r) {
     c.load_friction_reference_kN =
         fx->number_or("load_friction_reference_kN", c.load_friction_reference_kN, Range::positive());
     c.backlash_width_rev = fx->number_or("backlash_width_rev", c.backlash_width_rev, Range::closed(0.0, 0.5));
+    c.load_cell_offset_kN_per_C =
+        fx->number_or("load_cell_offset_kN_per_C", c.load_cell_offset_kN_per_C, Range::closed(-1.0, 1.0));
+    c.load_cell_offset_reference_C =
+        fx->number_or("load_cell_offset_reference_C", c.load_cell_offset_reference_C, Range::closed(-50.0, 150.0));
     fx->finish();
   }
   try {

@@ -83,7 +83,7 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
   const calibration::Estimate* fed = nullptr;
   const bool sensors_ok = monitor_.ok(Part::LoadCell) && monitor_.ok(Part::Resolver);
   if (check.usable() && check.load_cell_present && sensors_ok && !was_lost) {
-    e = calibrator_->update(calibration::Sample{r.time_s, r.position_rev, r.load_cell_kN});
+    e = calibrator_->update(calibration::Sample{r.time_s, r.position_rev, r.load_cell_kN, r.speed_rev_per_s, r.temperature_C});
     const double dt_s = std::isfinite(last_fed_time_s_) ? r.time_s - last_fed_time_s_ : 0.0;
     fused_kN_ = fusion_.update(e, dt_s);
     if (e.valid) last_fed_time_s_ = r.time_s;

@@ -258,7 +258,7 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
   md << "\n## Back into the online calibrator\n\n";
   if (terms.empty()) {
     md << "None of the accepted effects has an online calibrator term (available: viscous_friction, "
-          "sensor_delay, backlash, load_dependent_friction).\n";
+          "sensor_delay, backlash, load_dependent_friction, temperature_drift).\n";
   } else {
     md << "For a caliper recording (position in rev, force in kN), add to the calibrator config "
           "(docs/calibrator.md, \"Optional effect terms\"):\n\n```yaml\neffects:\n";

@@ -111,8 +111,10 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& options);
 // (on; the calibrator fits c_v itself), sensor_delay -> force_delay_s = the measured delay,
 // backlash -> backlash_width_rev = the measured width, load_dependent_friction ->
 // load_friction_gain (clamped to the calibrator's [0, 10]) and load_friction_reference_kN (the
-// force that gain applies at). Effects without an online term (temperature drift, creep,
-// inertia, recorded channels) give none.
+// force that gain applies at), temperature_drift -> load_cell_offset_kN_per_C (its sensor
+// offset per degC; the curve's own temperature shift is tracked online by the refits) and
+// load_cell_offset_reference_C. Effects without an online term (creep, inertia, recorded
+// channels) give none.
 struct CalibratorTerm {
   std::string key;
   double value = 0.0;

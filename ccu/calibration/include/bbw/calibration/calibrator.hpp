@@ -22,6 +22,7 @@ struct Sample {
   double position_rev = 0.0;  // resolver position, actuator revolutions
   double force_kN = 0.0;      // internal load-cell reading (true force + key friction)
   double speed_rev_s = std::numeric_limits<double>::quiet_NaN();  // resolver speed; NaN = not given
+  double temperature_C = std::numeric_limits<double>::quiet_NaN();  // caliper temperature; NaN = not given
 };
 
 struct Estimate {
@@ -123,6 +124,8 @@ class Calibrator {
   double load_scale(double x_rev) const;
   // Backlash: the spindle position (play operator of the resolver position; state below).
   double spindle_rev_ = 0.0;
+  // Load-cell thermal offset: the last finite temperature (the reference until one arrives).
+  double temperature_C_ = 0.0;
   std::vector<double> start_pos_rev_;    // x0_i at the current cycle's start (replay)
 
   // Fit workspace, sized at construction.

@@ -77,6 +77,13 @@ struct CalibratorConfig {
   // operator of the resolver position: inside the gap the spindle stays where it was. 0 = off;
   // at most 0.5.
   double backlash_width_rev = 0.0;
+  // load_cell_offset_kN_per_C: the load cell's zero drifts with temperature (./bbw analyze's
+  // temperature_drift: sensor_offset_per_degC about reference_temperature_C). The calibrator
+  // removes k (T - T_ref) from every reading before the model sees it, T = the sample's
+  // temperature (the last finite one when a sample has none; T_ref before the first).
+  // 0 = off; |k| at most 1.
+  double load_cell_offset_kN_per_C = 0.0;
+  double load_cell_offset_reference_C = 40.0;
 
   // Throws std::invalid_argument naming the field, its value and the rule.
   void validate() const;

@@ -5,6 +5,7 @@
 // Calibrator::update's friction estimate (tested against it). Allocates only in reset().
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -19,6 +20,8 @@ struct FrictionModel {
   double load_gain = 0.0;                    // g (0 = off)
   double load_reference_kN = 40.0;
   double backlash_width_rev = 0.0;           // 0 = off
+  double load_cell_offset_kN_per_C = 0.0;    // thermal zero drift k (0 = off)
+  double load_cell_offset_reference_C = 40.0;
   double curve_a = 0.0, curve_b = 0.0, curve_c = 0.0, curve_d = 0.0;  // F(x), kN
 };
 
@@ -43,10 +46,24 @@ class FrictionTracker {
     }
     return f + m.viscous_kN_per_rev_per_s * speed_rev_s;
   }
+  // What the load cell reads beyond the clamp force at temperature T: the friction above plus
+  // the thermal zero offset, as the calibrator removes it (a non-finite T: the last finite one;
+  // none yet: no offset).
+  double step_load_cell_excess(const FrictionModel& m, double x_rev, double speed_rev_s, double temperature_C) {
+    const double f = step(m, x_rev, speed_rev_s);
+    if (std::isfinite(temperature_C)) {
+      temperature_C_ = temperature_C;
+      have_temperature_ = true;
+    }
+    if (m.load_cell_offset_kN_per_C == 0.0 || !have_temperature_) return f;
+    return f + load_cell_offset_kN(m.load_cell_offset_kN_per_C, m.load_cell_offset_reference_C, temperature_C_);
+  }
 
  private:
   std::vector<double> pos_rev_;
   double spindle_rev_ = 0.0;
+  double temperature_C_ = 0.0;
+  bool have_temperature_ = false;
   bool started_ = false;
 };
 

@@ -39,6 +39,11 @@ inline double load_friction_scale(double gain, double reference_kN, double force
   return 1.0 + gain * (force_kN > 0.0 ? force_kN : 0.0) / reference_kN;
 }
 
+// Load-cell thermal offset k (T - T_ref), kN.
+inline double load_cell_offset_kN(double kN_per_C, double reference_C, double temperature_C) {
+  return kN_per_C * (temperature_C - reference_C);
+}
+
 // Steps all M elements at x; writes n_i into n_out (may be null). Returns sum K_i Delta_i n_i
 // when k is non-null, else 0.
 inline double elements_step(double x_rev, const double* delta_rev, double* pos_rev, std::size_t m,

@@ -14,6 +14,7 @@ struct Recording {
   std::vector<double> force_kN;   // internal load cell
   std::vector<double> truth_kN;   // external sensor / true clamp force; empty when absent
   std::vector<double> speed_rev_s;  // resolver speed; empty when absent
+  std::vector<double> temperature_C;  // caliper temperature; empty when absent
 };
 
 struct Score {

@@ -14,6 +14,7 @@ struct CornerReading {
   double speed_rev_per_s = 0.0;        // resolver speed
   double load_cell_kN = 0.0;           // internal load cell (NaN: no value, a dropout)
   double motor_current_A = 0.0;
+  double temperature_C = std::numeric_limits<double>::quiet_NaN();  // caliper temperature
   // The clamp-force command the corner was following in force mode; NaN in position mode.
   double force_command_kN = std::numeric_limits<double>::quiet_NaN();
 };
