@@ -143,3 +143,43 @@ TEST(CalibrateCli, ErrorsAreClearAndNonZero) {
   EXPECT_NE(r.output.find("bad.yaml"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("required key is missing"), std::string::npos) << r.output;
 }
+
+// --temperature maps the column that feeds the load-cell thermal offset term: the tool gives the
+// library's numbers with it, and other numbers without it (the term did act).
+TEST(CalibrateCli, TemperatureColumnFeedsTheThermalOffsetTerm) {
+  const auto dir = temp_dir("calibrate_cli_temp");
+  const auto sc = bbw::scenario::load_scenario(std::string(BBW_SOURCE_DIR_FALLBACK) + "/config/scenarios/paper_rig_44C.yaml");
+  auto rec = bbw::calibration::record_corner(sc, 0);
+  {
+    std::ofstream f(dir / "rig.csv");
+    f << "t,x,f_int,f_ext,temp\n";
+    for (std::size_t k = 0; k < rec.time_s.size(); ++k) {
+      const double temp_C = 40.0 + 0.5 * rec.time_s[k];  // a warming caliper: its load cell drifts
+      char line[200];
+      std::snprintf(line, sizeof line, "%.6f,%.9g,%.9g,%.9g,%.6f\n", rec.time_s[k], rec.position_rev[k],
+                    rec.force_kN[k] + 0.02 * (temp_C - 40.0), rec.truth_kN[k], temp_C);
+      f << line;
+    }
+  }
+  {
+    std::ofstream f(dir / "cal.yaml");
+    f << read_file(std::string(BBW_SOURCE_DIR_FALLBACK) + "/config/calibrator/robust.yaml")
+      << "effects:\n  load_cell_offset_kN_per_C: 0.02\n  load_cell_offset_reference_C: 40.0\n";
+  }
+  const std::string common = "--input " + (dir / "rig.csv").string() + " --config " + (dir / "cal.yaml").string() +
+                             " --time t --position x --force f_int --truth f_ext";
+  ASSERT_EQ(run(common + " --out " + (dir / "with").string() + " --temperature temp").exit_code, 0);
+  ASSERT_EQ(run(common + " --out " + (dir / "without").string()).exit_code, 0);
+  bbw::csv::ReadOptions o;
+  o.required = {"t", "x", "f_int", "f_ext", "temp"};
+  const auto table = bbw::csv::read((dir / "rig.csv").string(), o);
+  bbw::calibration::Recording r{table.column("t"), table.column("x"), table.column("f_int"), table.column("f_ext"), {},
+                                table.column("temp")};
+  const auto res = bbw::calibration::run_recording(bbw::calibration::load_config((dir / "cal.yaml").string()), r);
+  char expected[64];
+  std::snprintf(expected, sizeof expected, "\"max_abs_error_kN\": %.9g", res.score.max_abs_error_kN);
+  EXPECT_NE(read_file(dir / "with" / "summary.json").find(expected), std::string::npos) << expected;
+  EXPECT_EQ(read_file(dir / "without" / "summary.json").find(expected), std::string::npos) << expected;
+  EXPECT_NE(run(common + " --out " + (dir / "x").string() + " --temperature nope").output.find("'nope'"),
+            std::string::npos);
+}
