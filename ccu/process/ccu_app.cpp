@@ -361,8 +361,10 @@ void CcuApp::record_detections() {
     for (std::size_t p = 0; p < ch.seen.size(); ++p) {
       const faults::Diagnosis& d = m.diagnosis(static_cast<faults::Part>(p));
       faults::Diagnosis& seen = ch.seen[p];
+      // A finding upgraded later (e.g. actuator_lost -> actuator_not_releasing) is recorded at
+      // the time of the upgrade.
       if (d.present && (!seen.present || d.detected_s != seen.detected_s || d.finding != seen.finding)) {
-        if (detections_.size() < detections_.capacity()) detections_.push_back({ch.slot, d.finding, d.onset_s, d.detected_s});
+        if (detections_.size() < detections_.capacity()) detections_.push_back({ch.slot, d.finding, d.onset_s, d.finding_s});
       }
       seen = d;
     }

@@ -117,7 +117,7 @@ const std::array<CornerPlan, kSlots>& CcuCore::plan(double time_s) {
     p.available = v.available;
     p.feedback = v.feedback;
     p.curve = v.curve;
-    cap[s] = {v.available, v.force_limit_kN};
+    cap[s] = {v.available, v.force_limit_kN, v.held_kN};
     all_available = all_available && v.available;
   }
   if (!all_available && redistributor_) {

@@ -58,7 +58,7 @@ void Plant::reset(double position_rev) {
   sample_sensors();
 }
 
-void Plant::substep(double i_cmd_A, double torque_scale, double h_s) {
+void Plant::substep(double i_cmd_A, double torque_scale, bool seized, double h_s) {
   const auto& m = p_.motor;
   const auto& t = p_.transmission;
   // Current: first-order R/L lag towards the (clipped) command.
@@ -79,7 +79,7 @@ void Plant::substep(double i_cmd_A, double torque_scale, double h_s) {
   const double accel_rev_s2 =
       (torque_scale * torque_per_A_Nm_ * s_.current_A - load_Nm - drive_friction_Nm) / (inertia_kg_m2_ * kTwoPi);
   // Semi-implicit Euler: speed first, then position with the new speed.
-  s_.speed_rev_per_s += h_s * accel_rev_s2;
+  s_.speed_rev_per_s = seized ? 0.0 : s_.speed_rev_per_s + h_s * accel_rev_s2;
   s_.motor_position_rev += h_s * s_.speed_rev_per_s;
   const double x_prev = s_.position_rev;
   if (e_.backlash.enabled) {
@@ -111,7 +111,7 @@ const Measurement& Plant::step(const PlantInputs& inputs, double dt_s) {
   for (int k = 0; k < n; ++k) {
     s_.time_s += h;
     s_.temperature_C = c_.temperature_C + c_.temperature_rate_C_per_s * s_.time_s;
-    substep(i_cmd, torque_scale, h);
+    substep(i_cmd, torque_scale, inputs.seized, h);
   }
   // Key friction: rate-independent, so one update per step at the step's end position is
   // exact for a position that moves monotonically within the step.

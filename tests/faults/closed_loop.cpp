@@ -127,7 +127,7 @@ LoopResult run_closed_loop(const FaultScenario& fs, const LoopOptions& options) 
       std::array<CornerCapacity, kCorners> cap;
       for (std::size_t i = 0; i < kCorners; ++i) {
         const CornerView& v = ccu[i]->view();
-        cap[i] = {options.redistribute ? v.available : true, v.force_limit_kN};
+        cap[i] = {options.redistribute ? v.available : true, v.force_limit_kN, options.count_held_force ? v.held_kN : 0.0};
         rec.available[i] = v.available;
       }
       const Allocation a = redistributor.allocate(demand_total, cap);

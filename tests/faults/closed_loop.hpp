@@ -31,7 +31,8 @@ struct LoopOptions {
   MonitorParams monitor;          // actuator model fields are taken from the scenario's plant
   CcuWatchdogParams watchdog;
   double liveliness_lease_s = 0.02;
-  bool redistribute = true;          // false: the CCU keeps the nominal split (for comparison)  // a killed corner is reported LivelinessLost after this
+  bool redistribute = true;          // false: the CCU keeps the nominal split (for comparison)
+  bool count_held_force = true;      // false: a corner that does not release counts as braking 0
   // Called for every reading a corner sends; fills `out` with what reaches the CCU (default:
   // the reading itself). Tests add corrupt samples here.
   std::function<void(std::size_t corner, const CornerReading& r, std::vector<CornerReading>& out)> deliver;

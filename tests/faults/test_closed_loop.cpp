@@ -75,7 +75,7 @@ namespace {
 const std::vector<std::string>& campaign() {
   static const std::vector<std::string> names = {
       "load_cell_bias", "load_cell_drift", "load_cell_stuck", "load_cell_noise_burst", "load_cell_dropout",
-      "resolver_offset", "resolver_stuck", "actuator_torque_loss", "actuator_total_loss", "network_silence",
+      "resolver_offset", "resolver_stuck", "actuator_torque_loss", "actuator_total_loss", "actuator_seized", "network_silence",
       "network_delay", "process_kill", "ccu_kill"};
   return names;
 }
@@ -189,6 +189,47 @@ TEST(ClosedLoop, OneCornerLostDuringAStopTotalBackAbove90PercentWithin100ms) {
       EXPECT_LT(recovery_time_s(base, 0.9, kFaultAt, kStopEnd, 120.0), 0.0) << to_string(c) << " " << to_string(t);
     }
   }
+}
+
+// A seized actuator (FL jams at the 24 kN peak at 9.0 s) keeps its force when told to release.
+// The torque balance first finds the actuator lost (current without motion); once a release is
+// commanded and the brake does not move back, the finding becomes actuator_not_releasing. From
+// then on FL's held force counts on the front axle: FR is asked for less, so during the stop
+// held 10-13 s the total stays near the demand; counting FL as braking 0 (the reaction to a
+// lost actuator) over-brakes the front axle by FL's held force.
+TEST(ClosedLoop, ASeizedActuatorIsNamedNotReleasingAndItsHeldForceIsCounted) {
+  const auto fs = load("config/scenarios/faults/actuator_seized.yaml");
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  const auto& o = r.outcomes[0];
+  EXPECT_TRUE(o.detected && o.correct);
+  EXPECT_EQ(o.diagnosis, Finding::ActuatorNotReleasing);
+  const Diagnosis& d = r.diagnoses[0 * 5 + static_cast<std::size_t>(Part::Actuator)];
+  ASSERT_TRUE(d.present);
+  EXPECT_EQ(d.finding, Finding::ActuatorNotReleasing);
+  EXPECT_GE(d.finding_s, d.detected_s);
+  auto no_held = default_options();
+  no_held.count_held_force = false;
+  const auto base = run_closed_loop(fs, no_held);
+  auto front_excess = [](const LoopResult& res, const bbw::scenario::Scenario& s) {
+    double worst = 0.0, held = 0.0;  // worst: largest |front total - front demand|
+    for (const auto& p : res.periods) {
+      if (p.time_s < 10.3 || p.time_s > kStopEnd) continue;
+      const double front_demand = s.demand->front_share * p.demand_total_kN;
+      worst = std::max(worst, std::abs(p.true_kN[0] + p.true_kN[1] - front_demand));
+      held = std::max(held, p.true_kN[0]);
+    }
+    return std::pair{worst, held};
+  };
+  const auto [excess, held] = front_excess(r, fs.scenario);
+  const auto [base_excess, base_held] = front_excess(base, fs.scenario);
+  std::printf("seized FL: first detected %.1f ms after the seizure (%s), named not releasing %.1f ms after it;\n"
+              "front axle off its demand in the held stop by at most %.3f kN counting FL's held %.2f kN, %.3f kN not counting it\n",
+              o.latency_ms, "actuator", 1e3 * (d.finding_s - fs.faults.faults[0].at_s), excess, held, base_excess);
+  EXPECT_GT(held, 5.0);                 // the brake really held its force
+  EXPECT_GT(base_excess, 0.8 * held);   // without counting it, the front over-brakes by about that
+  EXPECT_LT(excess, 1.0);               // counting it, FR makes up only the rest
+  EXPECT_LT(d.finding_s - fs.faults.faults[0].at_s, 1.0);
 }
 
 TEST(ClosedLoop, CorruptSamplesNeverChangeACommandOrAnEstimate) {

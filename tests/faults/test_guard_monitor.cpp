@@ -248,6 +248,64 @@ TEST(FaultMonitor, TorqueBalanceSeparatesPartialAndTotalLoss) {
   EXPECT_EQ(run(0.1).finding, Finding::ActuatorLost);
 }
 
+// Over-application: told to release (command 0) a brake that keeps 10 kN and does not move back
+// is named actuator_not_releasing after tracking_persist_s past the point where the force stands
+// above the commanded response by the tracking threshold; one that moves back (releasing, if
+// slowly) or that holds what it is told is not.
+TEST(FaultMonitor, ABrakeThatDoesNotReleaseIsNamedAndOneThatMovesBackIsNot) {
+  MonitorParams p;
+  SampleCheck ok;
+  auto run = [&](double command_kN, double speed_rev_per_s, double until_s) {
+    FaultMonitor m(p, Target::FL);
+    for (int k = 1; 0.001 * k <= until_s + 1e-12; ++k) {
+      auto r = at(k, 0.001 * k, 4.0, 10.0);
+      r.speed_rev_per_s = speed_rev_per_s;
+      r.motor_current_A = 10.0 * p.Nm_per_kN / p.torque_per_A_Nm;  // the torque the load needs
+      r.force_command_kN = command_kN;
+      m.update(r, ok, nullptr, 10.0, r.time_s);
+    }
+    return m.diagnosis(Part::Actuator);
+  };
+  // The model falls below 10 - 3 kN at 0.1 s * ln(10/7) = 35.7 ms; confirmed 200 ms later.
+  EXPECT_FALSE(run(0.0, 0.0, 0.230).present);
+  const Diagnosis d = run(0.0, 0.0, 0.5);
+  ASSERT_TRUE(d.present);
+  EXPECT_EQ(d.finding, Finding::ActuatorNotReleasing);
+  EXPECT_NEAR(d.onset_s, 0.036, 0.0015);
+  EXPECT_NEAR(d.detected_s, 0.236, 0.0015);
+  EXPECT_EQ(part_of(d.finding), Part::Actuator);
+  EXPECT_FALSE(run(0.0, -0.6, 1.0).present);  // moving back faster than 0.5 rev/s: releasing
+  EXPECT_FALSE(run(10.0, 0.0, 1.0).present);  // holds what it is told
+  EXPECT_FALSE(run(8.0, 0.0, 1.0).present);   // 2 kN over: within the 3 kN threshold
+}
+
+// A part's finding is upgraded to not releasing (and finding_s records when); the first
+// detection time stays.
+TEST(FaultMonitor, ALostActuatorThatDoesNotReleaseIsUpgraded) {
+  MonitorParams p;
+  SampleCheck ok;
+  FaultMonitor m(p, Target::FL);
+  int k = 1;
+  for (; k < 100; ++k) {  // 10x the current the load needs, no motion: torque lost
+    auto r = at(k, 0.001 * k, 4.0, 20.0);
+    r.motor_current_A = 10.0 * 20.0 * p.Nm_per_kN / p.torque_per_A_Nm;
+    r.force_command_kN = 20.0;
+    m.update(r, ok, nullptr, 20.0, r.time_s);
+  }
+  ASSERT_EQ(m.diagnosis(Part::Actuator).finding, Finding::ActuatorLost);
+  const double first_s = m.diagnosis(Part::Actuator).detected_s;
+  for (; k < 600; ++k) {  // told to release, holds 20 kN
+    auto r = at(k, 0.001 * k, 4.0, 20.0);
+    r.motor_current_A = -30.0;
+    r.force_command_kN = 0.0;
+    m.update(r, ok, nullptr, 20.0, r.time_s);
+  }
+  const Diagnosis& d = m.diagnosis(Part::Actuator);
+  EXPECT_EQ(d.finding, Finding::ActuatorNotReleasing);
+  EXPECT_EQ(d.detected_s, first_s);
+  EXPECT_GT(d.finding_s, first_s + 0.2);
+}
+
 TEST(LastGoodCalibration, GivesTheNewestSnapshotBeforeATime) {
   const auto cfg = test::default_options().calibrator;
   bbw::calibration::Calibrator c(cfg);

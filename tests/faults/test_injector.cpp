@@ -162,6 +162,35 @@ TEST(FaultInjector, InCornerSimTheBiasReachesSampleAndLoopAndTotalLossReleasesTh
   EXPECT_GT(std::abs(sim.last().motor_current_A), 30.0);  // current flows, no torque
 }
 
+// A seized actuator: told to release after 1 s, the brake keeps its force and its position while
+// the motor pulls back at its current limit; a healthy one releases.
+TEST(FaultInjector, ASeizedActuatorHoldsItsForceWhenToldToRelease) {
+  const auto fs = load_fault_scenario(test::source_path("config/scenarios/faults/fault_free_stop.yaml"));
+  FaultInjector jam(one(spec(FaultType::Seized, Part::Actuator, 1.0)), Target::FL, 3);
+  EXPECT_FALSE(jam.seized(0.999));
+  EXPECT_TRUE(jam.seized(1.0));
+  EXPECT_DOUBLE_EQ(jam.torque_scale(1.5), 1.0);
+  bbw::scenario::CornerSim sim(fs.scenario, 0), healthy(fs.scenario, 0);
+  double force_at_1s = 0.0, position_at_1s = 0.0;
+  for (int k = 0; k < 2000; ++k) {
+    bbw::scenario::ExternalInputs ext;
+    ext.force_command_kN = k < 1000 ? 20.0 : 0.0;
+    bbw::scenario::ExternalInputs ext_h = ext;
+    jam.prepare(ext, sim.time_s() + 0.001);
+    sim.step(0.001, ext);
+    healthy.step(0.001, ext_h);
+    if (k == 999) {
+      force_at_1s = sim.last().force_true_kN;
+      position_at_1s = sim.plant().state().position_rev;
+    }
+  }
+  EXPECT_GT(force_at_1s, 18.0);
+  EXPECT_NEAR(sim.last().force_true_kN, force_at_1s, 0.5);  // only creep, if on, could move it
+  EXPECT_DOUBLE_EQ(sim.plant().state().position_rev, position_at_1s);
+  EXPECT_LT(sim.last().motor_current_A, -10.0);  // the motor pulls back, nothing moves
+  EXPECT_LT(healthy.last().force_true_kN, 1.0);
+}
+
 TEST(FaultInjector, ADropoutReachesTheSampleWhileTheLocalLoopHoldsItsLastValue) {
   const auto fs = load_fault_scenario(test::source_path("config/scenarios/faults/fault_free_stop.yaml"));
   FaultInjector inj(one(spec(FaultType::Dropout, Part::LoadCell, 1.0, 0.2)), Target::FL, 3);

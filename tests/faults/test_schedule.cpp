@@ -52,8 +52,8 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
       types.insert(fs.faults.faults[0].type);
     }
   }
-  EXPECT_EQ(files, 14u);
-  EXPECT_EQ(types.size(), 11u);  // every FaultType; stuck appears for both sensors
+  EXPECT_EQ(files, 15u);
+  EXPECT_EQ(types.size(), 12u);  // every FaultType; stuck appears for both sensors
 }
 
 TEST(FaultSchedule, ReadsEachTypeWithItsParameters) {

@@ -139,7 +139,7 @@ std::size_t expect_one_clean_restart(const std::string& out, const std::string& 
 
 class LockstepFault : public ::testing::TestWithParam<Case> {};
 
-// Domains 170-182: each fault type runs through the launcher in lockstep; every injected fault
+// Domains 170-182 and 188: each fault type runs through the launcher in lockstep; every injected fault
 // is detected and diagnosed right, and nothing else is raised on any corner.
 TEST_P(LockstepFault, IsDetectedAndDiagnosedRight) {
   const Case c = GetParam();
@@ -183,6 +183,14 @@ TEST_P(LockstepFault, IsDetectedAndDiagnosedRight) {
       EXPECT_GT(f.back(), 6.0) << k << ": released after the CCU died";
     }
   }
+  if (std::string(c.scenario) == "actuator_seized") {
+    // Found lost at once (current without motion), named not releasing once told to release.
+    ASSERT_EQ(faults.size(), 1u);
+    EXPECT_EQ(faults[0].at("diagnosis"), "actuator_not_releasing") << summary;
+    bool named = false;
+    for (const auto& d : detections) named = named || d.at("finding") == "actuator_not_releasing";
+    EXPECT_TRUE(named) << summary;
+  }
   if (std::string(c.scenario) == "process_kill") {
     // The restart: RR's second process joined at 11.5 s; no sample lost or applied twice.
     EXPECT_EQ(expect_one_clean_restart(dir + "/out", "RR", 11.0, 1e-9, 11.501, 11.501, true), 13500u);
@@ -194,7 +202,7 @@ INSTANTIATE_TEST_SUITE_P(
     EveryFaultType, LockstepFault,
     ::testing::Values(Case{"load_cell_bias", 170}, Case{"load_cell_drift", 171}, Case{"load_cell_stuck", 172},
                       Case{"load_cell_noise_burst", 173}, Case{"load_cell_dropout", 174}, Case{"resolver_offset", 175},
-                      Case{"resolver_stuck", 176}, Case{"actuator_torque_loss", 177}, Case{"actuator_total_loss", 178},
+                      Case{"resolver_stuck", 176}, Case{"actuator_torque_loss", 177}, Case{"actuator_total_loss", 178}, Case{"actuator_seized", 188},
                       Case{"network_silence", 179}, Case{"network_delay", 180}, Case{"process_kill", 181},
                       Case{"ccu_kill", 182}),
     [](const ::testing::TestParamInfo<Case>& i) { return std::string(i.param.scenario); });

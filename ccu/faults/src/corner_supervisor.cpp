@@ -142,6 +142,8 @@ void CornerSupervisor::refresh_view(const CornerReading* r, const SampleCheck* c
   const bool sensing = lc_ok || res_ok;
   view_.available = linked && actuator_usable && sensing;
   view_.force_limit_kN = monitor_.params().force_limit_kN;
+  const bool holding = act.active && act.finding == Finding::ActuatorNotReleasing;
+  view_.held_kN = holding && std::isfinite(view_.force_estimate_kN) ? std::max(0.0, view_.force_estimate_kN) : 0.0;
   if (!lc_ok && res_ok) {
     view_.feedback = corner_unit::ForceFeedback::Curve;
   } else if (!res_ok) {

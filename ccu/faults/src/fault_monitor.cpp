@@ -62,6 +62,7 @@ void MonitorParams::validate() const {
           "must be in [0, 1)");
   positive("tracking_persist_s", tracking_persist_s);
   positive("force_limit_kN", force_limit_kN);
+  positive("release_min_speed_rev_per_s", release_min_speed_rev_per_s);
   positive("deadline_s", deadline_s);
 }
 
@@ -77,6 +78,7 @@ const char* to_string(Finding f) {
     case Finding::ActuatorTorqueLoss: return "actuator_torque_loss";
     case Finding::ActuatorLost: return "actuator_lost";
     case Finding::ActuatorTracking: return "actuator_tracking";
+    case Finding::ActuatorNotReleasing: return "actuator_not_releasing";
     case Finding::LinkLost: return "link_lost";
     case Finding::ProcessLost: return "process_lost";
   }
@@ -89,7 +91,8 @@ Part part_of(Finding f) {
     case Finding::ResolverStuck: return Part::Resolver;
     case Finding::ActuatorTorqueLoss:
     case Finding::ActuatorLost:
-    case Finding::ActuatorTracking: return Part::Actuator;
+    case Finding::ActuatorTracking:
+    case Finding::ActuatorNotReleasing: return Part::Actuator;
     case Finding::LinkLost: return Part::Network;
     case Finding::ProcessLost: return Part::Process;
     default: return Part::LoadCell;
@@ -107,10 +110,16 @@ FaultMonitor::FaultMonitor(const MonitorParams& params, Target corner)
 void FaultMonitor::confirm(Finding f, double onset_s, double now_s) {
   Diagnosis& d = diag_[slot(part_of(f))];
   if (d.active) {
-    // An actuator that cannot track is worse than a torque loss: the finding is upgraded (the
-    // part was isolated at the first detection). Otherwise the first finding stays.
-    if ((f == Finding::ActuatorTracking || f == Finding::ActuatorLost) && d.finding == Finding::ActuatorTorqueLoss) {
+    // An actuator that cannot track is worse than a torque loss, and one that does not release
+    // is worse than any other actuator finding (its force must be counted, not just replaced):
+    // the finding is upgraded (the part was isolated at the first detection). Otherwise the
+    // first finding stays.
+    const bool upgrade =
+        ((f == Finding::ActuatorTracking || f == Finding::ActuatorLost) && d.finding == Finding::ActuatorTorqueLoss) ||
+        (f == Finding::ActuatorNotReleasing && d.finding != f);
+    if (upgrade) {
       d.finding = f;
+      d.finding_s = now_s;
     }
     return;
   }
@@ -127,6 +136,7 @@ void FaultMonitor::confirm(Finding f, double onset_s, double now_s) {
   d.finding = f;
   d.onset_s = onset_s;
   d.detected_s = now_s;
+  d.finding_s = now_s;
 }
 
 void FaultMonitor::set_curve_range(double min_rev, double max_rev) {
@@ -179,7 +189,7 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
     have_prev_ = false;           // no continuity across the gap
     have_prev_residual_ = false;
     model_init_ = false;
-    residual_suspect_ = tracking_suspect_ = torque_suspect_ = lost_suspect_ = false;
+    residual_suspect_ = tracking_suspect_ = excess_suspect_ = torque_suspect_ = lost_suspect_ = false;
     torque_init_ = false;
     lc_repeat_ = pos_repeat_ = missing_run_ = 0;
   }
@@ -378,7 +388,7 @@ void FaultMonitor::check_actuator(const CornerReading& r, const SampleCheck& c, 
   const double cmd = r.force_command_kN;
   if (!std::isfinite(cmd) || !std::isfinite(force_estimate_kN)) {
     model_init_ = false;
-    tracking_suspect_ = false;
+    tracking_suspect_ = excess_suspect_ = false;
     return;
   }
   if (!model_init_ || dt_s <= 0.0) {
@@ -387,8 +397,8 @@ void FaultMonitor::check_actuator(const CornerReading& r, const SampleCheck& c, 
   } else {
     model_kN_ += (cmd - model_kN_) * -std::expm1(-dt_s / p_.tracking_time_constant_s);
   }
-  // Only a shortfall counts: below both the command and the model (a release that is faster
-  // than the model is not a fault; a brake that does not release is not checked here).
+  // A shortfall counts below both the command and the model, an excess above both (a release
+  // faster than the model, or an apply faster than it, is not a fault).
   const double limit = std::max(p_.tracking_threshold_kN, p_.tracking_relative * std::abs(cmd));
   const bool reachable = cmd <= p_.force_limit_kN;
   if (reachable && std::min(cmd, model_kN_) - force_estimate_kN > limit) {
@@ -399,6 +409,18 @@ void FaultMonitor::check_actuator(const CornerReading& r, const SampleCheck& c, 
     if (t - tracking_onset_s_ >= p_.tracking_persist_s) confirm(Finding::ActuatorTracking, tracking_onset_s_, t);
   } else {
     tracking_suspect_ = false;
+  }
+  // Over-application: the brake holds a force well above what it is told and was told. Any
+  // command counts (a brake told to release must release, whatever the force limit).
+  const bool moving_back = r.speed_rev_per_s < -p_.release_min_speed_rev_per_s;
+  if (!moving_back && force_estimate_kN - std::max(cmd, model_kN_) > limit) {
+    if (!excess_suspect_) {
+      excess_suspect_ = true;
+      excess_onset_s_ = t;
+    }
+    if (t - excess_onset_s_ >= p_.tracking_persist_s) confirm(Finding::ActuatorNotReleasing, excess_onset_s_, t);
+  } else {
+    excess_suspect_ = false;
   }
 }
 

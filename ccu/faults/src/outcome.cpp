@@ -15,6 +15,8 @@ const char* reaction_to(Finding f) {
     case Finding::ActuatorTracking:
     case Finding::LinkLost:
     case Finding::ProcessLost: return "share redistributed to the remaining corners";
+    case Finding::ActuatorNotReleasing:
+      return "commanded to release; its held force counted on its axle, the rest redistributed";
     case Finding::None: return "none";
   }
   return "none";

@@ -44,8 +44,15 @@ double Redistributor::nominal_kN(std::size_t slot, double total_demand_kN) const
 Allocation Redistributor::allocate(double total_demand_kN, const std::array<CornerCapacity, kCorners>& corners) const {
   Allocation a;
   const double total = std::isfinite(total_demand_kN) ? std::max(0.0, total_demand_kN) : 0.0;
-  const double front_left = fill_pair(front_share_ * total, 0, 1, corners, a.force_kN);
-  const double rear_left = fill_pair((1.0 - front_share_) * total, 2, 3, corners, a.force_kN);
+  auto held = [&](std::size_t i) {
+    const double h = corners[i].held_kN;
+    return !corners[i].available && std::isfinite(h) ? std::max(0.0, h) : 0.0;
+  };
+  const double front_held = held(0) + held(1);
+  const double rear_held = held(2) + held(3);
+  a.held_kN = front_held + rear_held;
+  const double front_left = fill_pair(std::max(0.0, front_share_ * total - front_held), 0, 1, corners, a.force_kN);
+  const double rear_left = fill_pair(std::max(0.0, (1.0 - front_share_) * total - rear_held), 2, 3, corners, a.force_kN);
   // What one axle cannot deliver goes to the other.
   const double rear_spill = fill_pair(front_left, 2, 3, corners, a.force_kN);
   const double front_spill = fill_pair(rear_left, 0, 1, corners, a.force_kN);

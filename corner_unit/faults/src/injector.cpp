@@ -64,9 +64,16 @@ double FaultInjector::torque_scale(double time_s) const {
   return std::clamp(scale, 0.0, 1.0);
 }
 
+bool FaultInjector::seized(double time_s) const {
+  return std::any_of(faults_.begin(), faults_.end(), [&](const FaultSpec& f) {
+    return f.part == Part::Actuator && f.type == FaultType::Seized && f.active_at(time_s);
+  });
+}
+
 void FaultInjector::prepare(scenario::ExternalInputs& ext, double step_end_s) {
   ext.sensor_hook = this;
   ext.torque_scale = torque_scale(step_end_s);
+  ext.actuator_seized = seized(step_end_s);
 }
 
 bool FaultInjector::any_active(double time_s) const {

@@ -53,6 +53,7 @@ const char* to_string(FaultType t) {
     case FaultType::Offset: return "offset";
     case FaultType::TorqueLoss: return "torque_loss";
     case FaultType::TotalLoss: return "total_loss";
+    case FaultType::Seized: return "seized";
     case FaultType::Silence: return "silence";
     case FaultType::Delay: return "delay";
     case FaultType::Kill: return "kill";
@@ -88,7 +89,8 @@ std::optional<Part> part_of(FaultType t) {
     case FaultType::Dropout: return Part::LoadCell;
     case FaultType::Offset: return Part::Resolver;
     case FaultType::TorqueLoss:
-    case FaultType::TotalLoss: return Part::Actuator;
+    case FaultType::TotalLoss:
+    case FaultType::Seized: return Part::Actuator;
     case FaultType::Silence:
     case FaultType::Delay: return Part::Network;
     case FaultType::Kill: return Part::Process;

@@ -23,7 +23,7 @@ std::vector<std::string> types_of(Part p) {
   switch (p) {
     case Part::LoadCell: return {"bias", "drift", "stuck", "noise_burst", "dropout"};
     case Part::Resolver: return {"offset", "stuck"};
-    case Part::Actuator: return {"torque_loss", "total_loss"};
+    case Part::Actuator: return {"torque_loss", "total_loss", "seized"};
     case Part::Network: return {"silence", "delay"};
     case Part::Process: return {"kill"};
   }
@@ -39,6 +39,7 @@ FaultType type_from(const std::string& s) {
   if (s == "offset") return FaultType::Offset;
   if (s == "torque_loss") return FaultType::TorqueLoss;
   if (s == "total_loss") return FaultType::TotalLoss;
+  if (s == "seized") return FaultType::Seized;
   if (s == "silence") return FaultType::Silence;
   if (s == "delay") return FaultType::Delay;
   return FaultType::Kill;
@@ -76,6 +77,7 @@ FaultSpec read_one(config::Reader& r) {
     case FaultType::Stuck:
     case FaultType::Dropout:
     case FaultType::TotalLoss:
+    case FaultType::Seized:
     case FaultType::Silence: break;
   }
   if (f.type == FaultType::Silence && !r.has("duration_s")) r.fail("duration_s", "required key is missing (silence)");

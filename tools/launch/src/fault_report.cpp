@@ -68,6 +68,7 @@ const faults::Finding kFindings[] = {
     faults::Finding::LoadCellOffset, faults::Finding::LoadCellStuck,   faults::Finding::LoadCellNoisy,
     faults::Finding::LoadCellMissing, faults::Finding::ResolverOffset, faults::Finding::ResolverStuck,
     faults::Finding::ActuatorTorqueLoss, faults::Finding::ActuatorLost, faults::Finding::ActuatorTracking,
+    faults::Finding::ActuatorNotReleasing,
     faults::Finding::LinkLost,        faults::Finding::ProcessLost};
 
 const char* reaction_for(const std::string& finding) {
@@ -128,9 +129,15 @@ std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, co
       r.latency_ms = 1e3 * (first->detected_s - f.at_s);
       r.diagnosis_s = best->detected_s;
       r.diagnosis_latency_ms = 1e3 * (best->detected_s - f.at_s);
-      r.diagnosis = best->finding;
+      // The diagnosis is that part's final finding: a later upgrade of the same part (e.g.
+      // actuator_lost -> actuator_not_releasing once a release is commanded) refines it.
+      const Detection* last = best;
+      for (const Detection& d : detections) {
+        if (d.corner == corner && d.part == best->part && d.detected_s >= last->detected_s) last = &d;
+      }
+      r.diagnosis = last->finding;
       r.correct = best->part == expected;
-      r.reaction = reaction_for(best->finding);
+      r.reaction = reaction_for(last->finding);
     }
     out.push_back(r);
   }

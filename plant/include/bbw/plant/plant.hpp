@@ -21,6 +21,10 @@ struct PlantInputs {
   // Fault injection (docs/faults.md): the fraction of the motor's torque that reaches the
   // spindle, in [0, 1]; 1 is a healthy actuator. The current (and its sensor) is unaffected.
   double torque_scale = 1.0;
+  // Fault injection: the mechanism is jammed (gear or screw seized). Motor and spindle cannot
+  // turn whatever the torque; the clamp force stays where the pads hold it (creep still
+  // relaxes it). The current follows its command as before.
+  bool seized = false;
 };
 
 // Physical state (the truth).
@@ -79,7 +83,7 @@ class Plant {
   double resolver_quantum_rev() const { return quantum_rev_; }
 
  private:
-  void substep(double i_cmd_A, double torque_scale, double h_s);
+  void substep(double i_cmd_A, double torque_scale, bool seized, double h_s);
   void sample_sensors();
 
   PlantParams p_;

@@ -71,6 +71,7 @@ struct ExternalInputs {
   // Fault injection (docs/faults.md): the plant's torque scale for this step (1 = healthy) and
   // an optional sensor hook; neither changes anything at their defaults.
   double torque_scale = 1.0;
+  bool actuator_seized = false;  // the mechanism jams (plant::PlantInputs::seized)
   SensorHook* sensor_hook = nullptr;
 };
 

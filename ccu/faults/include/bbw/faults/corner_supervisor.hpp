@@ -36,6 +36,9 @@ struct CornerView {
   EstimateSource source = EstimateSource::None;
   bool available = false;        // may be given a share of the braking demand
   double force_limit_kN = 0.0;   // for the Redistributor
+  // A corner whose actuator does not release (ActuatorNotReleasing) still brakes with this
+  // force (its current estimate); 0 otherwise. The Redistributor counts it on its axle.
+  double held_kN = 0.0;
   // Force feedback the corner should use instead of its own choice (a reaction), if any.
   std::optional<corner_unit::ForceFeedback> feedback;
   calibration::Curve curve;      // the curve the CCU trusts for this corner

@@ -72,12 +72,17 @@ struct MonitorParams {
   double torque_persist_s = 0.04;
   double torque_lost_threshold = 0.25;        // at any speed, below this: the actuator is lost
   double torque_lost_persist_s = 0.015;
-  // Tracking backstop: the force against a first-order model of the commanded response.
+  // Tracking backstop: the force against a first-order model of the commanded response. A
+  // shortfall below both is ActuatorTracking; an excess above both (a brake that does not
+  // release) is ActuatorNotReleasing, with the same threshold and persistence.
   double tracking_time_constant_s = 0.1;
   double tracking_threshold_kN = 3.0;
   double tracking_relative = 0.3;             // of the command
   double tracking_persist_s = 0.2;
   double force_limit_kN = 40.0;               // commands above it are not expected to be reached
+  // An excess is a brake that does not release only while it does not move back at least this
+  // fast (a brake that releases, if slowly, e.g. back-driven after a torque loss, moves).
+  double release_min_speed_rev_per_s = 0.5;
 
   // Link: no sample for this long is a lost link (the DDS deadline in the process).
   double deadline_s = 0.015;
@@ -97,6 +102,7 @@ enum class Finding : std::uint8_t {
   ActuatorTorqueLoss,  // part of the torque is missing; the loop still reaches the command
   ActuatorLost,        // (almost) no torque for the current drawn
   ActuatorTracking,    // cannot follow a reachable command
+  ActuatorNotReleasing,  // holds a force well above the command (jammed, seized): over-application
   LinkLost,          // deadline missed / no samples
   ProcessLost,       // liveliness lost, or a new process of the corner joined
 };
@@ -109,6 +115,7 @@ struct Diagnosis {
   Finding finding = Finding::None;
   double onset_s = 0.0;    // when the condition started (best estimate)
   double detected_s = 0.0; // when it was confirmed
+  double finding_s = 0.0;  // when the current finding was confirmed (later after an upgrade)
 };
 
 // Restarted: a new process of the corner (a higher incarnation) has sent its first samples, so
@@ -208,6 +215,8 @@ class FaultMonitor {
   double torque_fraction_ = 1.0;
   bool tracking_suspect_ = false;
   double tracking_onset_s_ = 0.0;
+  bool excess_suspect_ = false;
+  double excess_onset_s_ = 0.0;
   bool model_init_ = false;
   double model_kN_ = 0.0;
   // link

@@ -9,6 +9,11 @@
 // corner (keeping the front/rear balance, which decides stability under braking) and only
 // beyond its limit to the rear; the side-to-side imbalance this creates is left to the
 // vehicle's yaw control (steering/ESC), which this simulation does not model.
+//
+// An unavailable corner may still brake: one whose actuator does not release holds held_kN.
+// That force counts towards its own axle's part (the partner is asked for less, down to 0);
+// what it holds beyond its axle's part is not taken off the other axle (a jammed rear brake
+// must not shift the balance to the rear), so the total can then exceed the demand.
 #pragma once
 
 #include <array>
@@ -21,11 +26,13 @@ inline constexpr std::size_t kCorners = 4;  // FL, FR, RL, RR (corner_slot order
 struct CornerCapacity {
   bool available = true;
   double limit_kN = 40.0;
+  double held_kN = 0.0;  // force an unavailable corner delivers anyway (ignored when available)
 };
 
 struct Allocation {
-  std::array<double, kCorners> force_kN{};  // 0 for unavailable corners
-  double total_kN = 0.0;                    // sum of force_kN
+  std::array<double, kCorners> force_kN{};  // commands; 0 for unavailable corners
+  double total_kN = 0.0;                    // sum of force_kN (held forces not included)
+  double held_kN = 0.0;                     // sum of the unavailable corners' held forces
   double shortfall_kN = 0.0;                // demand that no available corner could take
 };
 

@@ -32,8 +32,11 @@ class FaultInjector final : public scenario::SensorHook {
 
   // The fraction of motor torque the actuator delivers at time_s (1 when healthy).
   double torque_scale(double time_s) const;
+  // Whether the actuator is seized (jammed) at time_s.
+  bool seized(double time_s) const;
 
-  // Sets ext.sensor_hook = this and ext.torque_scale for a step ending at step_end_s.
+  // Sets ext.sensor_hook = this, ext.torque_scale and ext.actuator_seized for a step ending at
+  // step_end_s.
   void prepare(scenario::ExternalInputs& ext, double step_end_s);
 
   // True when any sensor or actuator fault of this corner is active at time_s.

@@ -21,6 +21,7 @@ enum class FaultType {
   Offset,      // resolver: + offset_rev
   TorqueLoss,  // actuator: torque_loss_percent of the motor torque is lost
   TotalLoss,   // actuator: no motor torque
+  Seized,      // actuator: the mechanism jams; the spindle cannot turn (the brake holds its force)
   Silence,     // network: the corner's messages stop (for duration_s, required)
   Delay,       // network: the corner's messages arrive delay_ms late
   Kill,        // process: the corner (or CCU) process is killed; optionally restarted
