@@ -94,10 +94,7 @@ bool from_msg(const msg::CalibrationState& in, CalibrationModel& out) {
   f.backlash_width_rev = in.backlash_width_rev();
   f.load_cell_offset_kN_per_C = in.load_cell_offset_kN_per_C();
   f.load_cell_offset_reference_C = in.load_cell_offset_reference_C();
-  f.curve_a = out.curve.a;
-  f.curve_b = out.curve.b;
-  f.curve_c = out.curve.c;
-  f.curve_d = out.curve.d;
+  f.curve = {out.curve.a, out.curve.b, out.curve.c, out.curve.d};
   out.version = in.version();
   return true;
 }

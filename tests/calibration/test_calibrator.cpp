@@ -207,10 +207,7 @@ TEST(FrictionTracker, GivesTheCalibratorsFrictionEstimate) {
   m.load_gain = 0.7;
   m.load_reference_kN = 30.0;
   m.backlash_width_rev = 0.04;
-  m.curve_a = 0.0;
-  m.curve_b = 0.5;
-  m.curve_c = 4.0;
-  m.curve_d = -3.0;
+  m.curve = c.initial_curve;  // the curve the calibrator scales its friction along
   m.load_cell_offset_kN_per_C = -0.03;
   m.load_cell_offset_reference_C = 35.0;
   FrictionTracker tracker;

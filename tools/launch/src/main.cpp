@@ -410,9 +410,13 @@ int main(int argc, char** argv) {
       const long long in_flight =
           static_cast<long long>(corner_sum("samples_in_flight") + corner_sum("samples_without_ccu"));
       const long long rec = static_cast<long long>(num(ccu, p + "samples_received", ccu_stats_file));
-      const long long g = static_cast<long long>(num(ccu, p + "sample_gaps", ccu_stats_file) +
-                                                 num(ccu, p + "block_gaps", ccu_stats_file) +
-                                                 corner_sum("command_seq_gaps"));
+      // Measurement samples missing at the CCU, measurement block numbers skipped, and commands
+      // the corner never saw (realtime: a corner follows the newest, so only the first matters
+      // for "no sample lost"); sequence_gaps is their sum.
+      const long long sample_gaps = static_cast<long long>(num(ccu, p + "sample_gaps", ccu_stats_file));
+      const long long block_gaps = static_cast<long long>(num(ccu, p + "block_gaps", ccu_stats_file));
+      const long long command_gaps = static_cast<long long>(corner_sum("command_seq_gaps"));
+      const long long g = sample_gaps + block_gaps + command_gaps;
       published += pub;
       in_flight_total += in_flight;
       received += rec;
@@ -450,6 +454,9 @@ int main(int argc, char** argv) {
           .value("samples_published", pub)
           .value("samples_received", rec)
           .value("sequence_gaps", g)
+          .value("sample_gaps", sample_gaps)
+          .value("block_gaps", block_gaps)
+          .value("command_gaps", command_gaps)
           .value("samples_suppressed_by_fault", static_cast<long long>(corner_sum("samples_suppressed")))
           .value("samples_not_receivable", in_flight)
           .value("incarnations", static_cast<long long>(incarnations[c.name]))

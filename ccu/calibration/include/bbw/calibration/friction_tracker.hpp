@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "bbw/calibration/curve.hpp"
 #include "bbw/calibration/maxwell_slip.hpp"
 
 namespace bbw::calibration {
@@ -22,7 +23,7 @@ struct FrictionModel {
   double backlash_width_rev = 0.0;           // 0 = off
   double load_cell_offset_kN_per_C = 0.0;    // thermal zero drift k (0 = off)
   double load_cell_offset_reference_C = 40.0;
-  double curve_a = 0.0, curve_b = 0.0, curve_c = 0.0, curve_d = 0.0;  // F(x), kN
+  Curve curve;                               // F(x), for the load-dependent scaling
 };
 
 class FrictionTracker {
@@ -41,8 +42,7 @@ class FrictionTracker {
     double f = elements_step(x, m.delta_rev.data(), pos_rev_.data(), pos_rev_.size(), m.stiffness_kN_per_rev.data(),
                              nullptr);
     if (m.load_gain > 0.0) {
-      const double curve_kN = ((m.curve_a * x + m.curve_b) * x + m.curve_c) * x + m.curve_d;
-      f *= load_friction_scale(m.load_gain, m.load_reference_kN, curve_kN);
+      f *= load_friction_scale(m.load_gain, m.load_reference_kN, m.curve.force_kN(x));
     }
     return f + m.viscous_kN_per_rev_per_s * speed_rev_s;
   }
