@@ -3,14 +3,13 @@
 #include <signal.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <stdexcept>
 
-#include "bbw/dds/convert.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/faults/link_faults.hpp"
 #include "bbw/launch/stats_file.hpp"
+#include "bbw/node/csv_log.hpp"
 #include "bbw/security/dds_security.hpp"
 
 namespace bbw::ccu {
@@ -18,22 +17,6 @@ namespace bbw::ccu {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::vector<CornerChannel> make_channels(const scenario::Scenario& s) {
-  std::vector<CornerChannel> out;
-  for (const auto& c : s.corners) {
-    const auto corner = dds::parse_corner(c.name);  // CcuCore has checked the names
-    CornerChannel ch;
-    ch.corner = *corner;
-    ch.slot = dds::corner_index(*corner);
-    out.push_back(std::move(ch));
-  }
-  const double ratio = s.ccu_period_s / s.plant_dt_s;
-  if (std::fabs(ratio - std::round(ratio)) > 1e-9 || std::round(ratio) < 1 || std::round(ratio) > msg::MAX_BLOCK_SAMPLES) {
-    throw std::invalid_argument(s.file + ": ccu_period_s / plant_dt_s must be an integer in [1, 64]");
-  }
-  return out;
-}
 
 dds::ParticipantOptions named(dds::ParticipantOptions p) {
   if (p.name.empty()) p.name = "bbw_ccu";
@@ -45,29 +28,6 @@ std::uint64_t step_at(double time_s, double period_s) {
   return static_cast<std::uint64_t>(std::max(0.0, std::ceil(time_s / period_s - 1e-9)));
 }
 
-faults::CornerReading reading_from(const msg::MeasurementSample& s) {
-  faults::CornerReading r;
-  r.seq = s.seq();
-  r.time_s = s.time_s();
-  r.position_rev = s.position_rev();
-  r.speed_rev_per_s = s.speed_rev_s();
-  r.load_cell_kN = s.force_internal_kN();
-  r.motor_current_A = s.motor_current_A();
-  r.temperature_C = s.temperature_C();
-  r.force_command_kN = (s.status() & msg::STATUS_FORCE_MODE) ? s.command() : std::nan("");
-  return r;
-}
-
-std::uint8_t feedback_code(const std::optional<corner_unit::ForceFeedback>& f) {
-  if (!f) return msg::FEEDBACK_OWN;
-  return *f == corner_unit::ForceFeedback::Curve ? msg::FEEDBACK_CURVE : msg::FEEDBACK_LOAD_CELL;
-}
-
-const char* kCsvHeader =
-    "time_s,seq,block_seq,position_rev,speed_rev_s,force_internal_kN,force_external_kN,force_true_kN,"
-    "temperature_C,motor_current_A,command,force_mode,estimate_kN,friction_kN,curve_kN,fused_kN,valid,"
-    "calibrated,source,available,accepted\n";
-
 }  // namespace
 
 CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator,
@@ -75,22 +35,21 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
     : scenario_(scenario),
       options_(options),
       events_(events),
-      core_(scenario, calibrator),
-      periods_(static_cast<std::uint64_t>(std::ceil(scenario.duration_s / scenario.ccu_period_s - 1e-9))),
-      channels_(make_channels(scenario)),
+      node_(scenario, calibrator, options.friction_feedback),
+      periods_(node_.periods()),
       participant_(named(options.participant)),
       commands_(participant_, dds::kCommandTopic,
                 dds::profiles_for(options.mode == ClockMode::Lockstep).command_writer, events),
       calibration_(participant_, dds::kCalibrationTopic, "state_writer", events) {
-  for (const auto& ch : channels_) {
-    const dds::Partition partition{security::corner_partition(static_cast<int>(ch.slot))};
-    blocks_.push_back(std::make_unique<BlockReader>(
+  for (std::size_t i = 0; i < node_.channels(); ++i) {
+    const dds::Partition partition{security::corner_partition(static_cast<int>(node_.channel(i).slot))};
+    blocks_.push_back(std::make_unique<BlockInlet>(
         participant_, dds::kMeasurementTopic,
         dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_reader, events, partition));
-    health_.push_back(std::make_unique<HealthReader>(participant_, dds::kHealthTopic, "state_reader", events, partition));
+    health_.push_back(std::make_unique<HealthInlet>(participant_, dds::kHealthTopic, "state_reader", events, partition));
   }
+  instances_.resize(node_.channels());
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
-  detections_.reserve(256);
   if (options.process_faults) {
     for (const faults::ProcessAction& a : faults::process_actions(options.schedule)) {
       if (a.target == faults::Target::CCU) {
@@ -101,68 +60,40 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
     }
   }
   if (options.out_dir.empty()) return;
-  for (auto& ch : channels_) {
-    const std::string file = options.out_dir + "/ccu_" + dds::corner_name(ch.corner) + ".csv";
-    ch.csv = std::fopen(file.c_str(), "w");
-    if (ch.csv == nullptr) throw std::runtime_error(file + ": cannot write");
-    std::fputs(kCsvHeader, ch.csv);
-  }
-  const std::string file = options.out_dir + "/ccu_periods.csv";
-  periods_csv_ = std::fopen(file.c_str(), "w");
-  if (periods_csv_ == nullptr) throw std::runtime_error(file + ": cannot write");
-  std::fputs("time_s,demand_total_kN,command_total_kN,cmd_FL,cmd_FR,cmd_RL,cmd_RR,avail_FL,avail_FR,avail_RL,avail_RR\n",
-             periods_csv_);
+  log_ = std::make_unique<node::CcuCsvLog>(options.out_dir, node_);
+  node_.set_observer(log_.get());
 }
 
 CcuApp::~CcuApp() {
+  node_.set_observer(nullptr);
   // The readers go before the participant (members are destroyed after this body).
   blocks_.clear();
   health_.clear();
-  for (auto& ch : channels_) {
-    if (ch.csv != nullptr) std::fclose(ch.csv);
-  }
-  if (periods_csv_ != nullptr) std::fclose(periods_csv_);
-}
-
-CornerChannel* CcuApp::channel(std::uint8_t wire_id) {
-  for (auto& ch : channels_) {
-    if (dds::corner_index(ch.corner) == wire_id) return &ch;
-  }
-  return nullptr;
 }
 
 double CcuApp::realtime_now_s() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
 
 void CcuApp::drain_health() {
   msg::CornerHealth h;
-  for (std::size_t i = 0; i < channels_.size(); ++i) {
-    CornerChannel& ch = channels_[i];
-    while (health_[i]->take(h)) {
-      if (h.corner_id() != ch.slot) {
-        ++ch.foreign_health;  // another corner id in this corner's partition
-        continue;
-      }
-      if (h.incarnation() < ch.health_incarnation) continue;  // an older process's last word
-      ch.health_incarnation = h.incarnation();
-      ch.health = h.status();
-    }
+  for (std::size_t i = 0; i < node_.channels(); ++i) {
+    while (health_[i]->take(h)) node_.on_health(i, h);
   }
 }
 
 bool CcuApp::wait_for_corners(std::string& error) {
-  const int n = static_cast<int>(channels_.size());
+  const int n = static_cast<int>(node_.channels());
   const bool ok = events_.wait_for(options_.discovery_timeout, [&] {
     drain_health();
-    bool all = commands_.matched() >= n && calibration_.matched() >= n;
-    for (std::size_t i = 0; i < channels_.size(); ++i) all = all && channels_[i].health >= 0 && blocks_[i]->matched() >= 1;
+    bool all = commands_.peers() >= n && calibration_.peers() >= n;
+    for (std::size_t i = 0; i < node_.channels(); ++i) all = all && node_.channel(i).health >= 0 && blocks_[i]->peers() >= 1;
     return all;
   });
   if (!ok && !events_.interrupted()) {
     int matched_blocks = 0;
-    for (const auto& r : blocks_) matched_blocks += r->matched() >= 1 ? 1 : 0;
+    for (const auto& r : blocks_) matched_blocks += r->peers() >= 1 ? 1 : 0;
     std::string missing;
-    for (const auto& ch : channels_) {
-      if (ch.health < 0) missing += (missing.empty() ? "" : ", ") + std::string(dds::corner_name(ch.corner));
+    for (std::size_t i = 0; i < node_.channels(); ++i) {
+      if (node_.channel(i).health < 0) missing += (missing.empty() ? "" : ", ") + std::string(corner_name(node_.channel(i).corner));
     }
     error = "corners not discovered within " + std::to_string(options_.discovery_timeout.count()) +
             " ms: " + (missing.empty() ? std::string("(endpoints incomplete)") : missing) +
@@ -172,222 +103,57 @@ bool CcuApp::wait_for_corners(std::string& error) {
 }
 
 void CcuApp::send_commands(std::uint64_t step, bool stop, bool log) {
-  const double t = static_cast<double>(step) * scenario_.ccu_period_s;
-  const auto& plans = core_.plan(t);
-  double total = 0.0;
-  for (auto& ch : channels_) {
-    const CornerPlan& p = plans[ch.slot];
-    msg::ClampCommand c;
-    c.corner_id(static_cast<std::uint8_t>(ch.slot));
-    c.seq(ch.command_seq++);
-    c.step(step);
-    c.time_s(t);
-    c.mode(p.mode == CommandMode::Force ? msg::MODE_FORCE : msg::MODE_PROFILE);
-    c.clamp_force_kN(p.clamp_force_kN);
-    c.valid(!stop);
-    c.use_friction_comp(options_.friction_feedback);
-    c.calibration_version(ch.calibration_version);
-    c.friction_estimate_kN(0.0);
-    c.stop(stop);
-    c.feedback_override(feedback_code(p.feedback));
-    c.override_curve_a_kN_per_rev3(p.curve.a);
-    c.override_curve_b_kN_per_rev2(p.curve.b);
-    c.override_curve_c_kN_per_rev(p.curve.c);
-    c.override_curve_d_kN(p.curve.d);
-    commands_.write(c);
-    if (p.mode == CommandMode::Force) total += p.clamp_force_kN;
-  }
-  if (periods_csv_ != nullptr && !stop && log) {
-    char line[512];
-    int n = std::snprintf(line, sizeof(line), "%.6f,%.9g,%.9g", t, core_.demand_total_kN(t), total);
-    for (std::size_t s = 0; s < kSlots; ++s) {
-      const bool has = core_.has(s);
-      n += std::snprintf(line + n, sizeof(line) - static_cast<std::size_t>(n), has ? ",%.9g" : ",nan",
-                         has && plans[s].mode == CommandMode::Force ? plans[s].clamp_force_kN : std::nan(""));
-    }
-    for (std::size_t s = 0; s < kSlots; ++s) {
-      n += std::snprintf(line + n, sizeof(line) - static_cast<std::size_t>(n), ",%d",
-                         core_.has(s) && plans[s].available ? 1 : 0);
-    }
-    line[n++] = '\n';
-    std::fwrite(line, 1, static_cast<std::size_t>(n), periods_csv_);
-  }
+  for (const msg::ClampCommand& c : node_.commands(step, stop, log)) commands_.send(c);
 }
 
-void CcuApp::publish_calibration(CornerChannel& ch, double time_s) {
-  const faults::CornerSupervisor& sup = core_.supervisor(ch.slot);
-  const auto fits = sup.calibrator().stats().fits_accepted;
-  const auto restarts = sup.calibrator_restarts();
-  if (fits == ch.published_fits && restarts == ch.published_restarts) return;
-  // A fit was accepted, or the calibrator restarted from the last good curve (a rejoin).
-  ch.published_fits = fits;
-  ch.published_restarts = restarts;
-  ++ch.calibration_version;
-  msg::CalibrationState state;
-  dds::to_msg(sup.calibrator(), static_cast<std::uint8_t>(ch.slot), ch.calibration_version, time_s, state);
-  calibration_.write(state);
-}
-
-void CcuApp::process_block(CornerChannel& channel_of_partition, const msg::MeasurementBlock& b,
-                           const eprosima::fastdds::dds::SampleInfo& info, double arrival_s) {
-  if (b.corner_id() != channel_of_partition.slot) {
-    // Another corner id in this corner's partition: a corner posing as another (or as one
-    // that does not exist). Dropped and counted before anything reads it.
-    ++channel_of_partition.foreign_blocks;
-    if (channel(b.corner_id()) == nullptr) ++unknown_corner_blocks_;
-    return;
-  }
-  CornerChannel* ch = &channel_of_partition;
-  ch->instance = info.instance_handle;
-  if (!ch->have_handles || ch->writer != info.publication_handle) {
-    ch->writer = info.publication_handle;
-    ch->writer_alive = true;
-    ch->have_handles = true;
-  }
-  if (b.incarnation() != ch->incarnation) {
-    // A restarted process: its block and sample numbering start where it joined.
-    ch->incarnation = b.incarnation();
-    ch->next_block = b.block_seq();
-    ch->next_sample_seq = b.samples().empty() ? 1 : b.samples().front().seq();
-    ++ch->rejoins;
-    core_.on_link_event(ch->slot, faults::LinkEvent::Restarted, arrival_s);
-  }
-  if (b.block_seq() != ch->next_block) ++ch->block_gaps;
-  // Never backwards within an incarnation: an old or forged block number cannot make the
-  // lockstep clock wait again for a block it already has (it stalled the run until the peer
-  // timeout before).
-  ch->next_block = std::max(ch->next_block, b.block_seq() + 1);
-  ++ch->blocks_received;
-  if (!b.samples().empty() && b.samples().front().seq() != ch->next_sample_seq) {
-    ch->sample_gaps += b.samples().front().seq() > ch->next_sample_seq ? b.samples().front().seq() - ch->next_sample_seq : 1;
-  }
-  for (const auto& s : b.samples()) {
-    ++ch->samples_received;
-    ch->next_sample_seq = s.seq() + 1;
-    const faults::CornerReading r = reading_from(s);
-    const std::uint64_t rejected_before = core_.supervisor(ch->slot).guard().rejected();
-    const SampleOutcome& o = core_.on_sample(ch->slot, r, arrival_s);
-    const bool accepted = core_.supervisor(ch->slot).guard().rejected() == rejected_before;
-    if (!accepted) ++ch->samples_invalid;
-    if (ch->csv != nullptr) {
-      // Shortest round-trip decimal form (std::to_chars): exact, and far cheaper than %.17g.
-      char line[700];
-      char* p = line;
-      char* const last = line + sizeof(line);
-      // One character is kept back for each separator, so a full buffer truncates, never overflows.
-      auto put = [&](double v) {
-        p = std::to_chars(p, last - 1, v).ptr;
-        *p++ = ',';
-      };
-      auto put_u = [&](unsigned long long v) {
-        p = std::to_chars(p, last - 1, v).ptr;
-        *p++ = ',';
-      };
-      put(s.time_s());
-      put_u(s.seq());
-      put_u(b.block_seq());
-      for (double v : {s.position_rev(), s.speed_rev_s(), s.force_internal_kN(), s.force_external_kN(),
-                       s.force_true_kN(), s.temperature_C(), s.motor_current_A(), s.command()}) {
-        put(v);
-      }
-      put_u((s.status() & msg::STATUS_FORCE_MODE) ? 1 : 0);
-      const double nan = std::nan("");
-      for (double v : {o.valid ? o.estimate_kN : nan, o.valid ? o.friction_kN : nan, o.valid ? o.curve_kN : nan,
-                       o.valid ? o.fused_kN : nan}) {
-        put(v);
-      }
-      put_u(o.valid ? 1 : 0);
-      put_u(o.calibrated ? 1 : 0);
-      put_u(static_cast<unsigned long long>(core_.supervisor(ch->slot).view().source));
-      put_u(core_.supervisor(ch->slot).view().available ? 1 : 0);
-      put_u(accepted ? 1 : 0);  // the sample guard let this sample through
-      p[-1] = '\n';
-      std::fwrite(line, 1, static_cast<std::size_t>(p - line), ch->csv);
-    }
-  }
-  if (b.block_seq() + 1 >= periods_) ch->finished = true;
-  publish_calibration(*ch, b.samples().empty() ? arrival_s : b.samples().back().time_s());
+void CcuApp::send_calibration_updates() {
+  for (const msg::CalibrationState& s : node_.calibration_updates()) calibration_.send(s);
+  node_.clear_calibration_updates();
 }
 
 void CcuApp::drain_blocks(double arrival_s) {
-  eprosima::fastdds::dds::SampleInfo info;
   const bool realtime = options_.mode == ClockMode::Realtime;
-  for (std::size_t i = 0; i < channels_.size(); ++i) {
-    CornerChannel& ch = channels_[i];
-    while (blocks_[i]->take(block_, info)) {
-      if (ch.block_tokens < 1.0) {
-        ++ch.blocks_over_rate;  // beyond the corner's rate: dropped unread
-        continue;
-      }
-      ch.block_tokens -= 1.0;
-      process_block(ch, block_, info, realtime ? realtime_now_s() : arrival_s);
+  transport::EndpointId writer = 0;
+  for (std::size_t i = 0; i < node_.channels(); ++i) {
+    while (blocks_[i]->take(block_, writer)) {
+      if (block_.corner_id() == node_.channel(i).slot) instances_[i] = blocks_[i]->last_info().instance_handle;
+      node_.on_block(i, block_, writer, realtime ? realtime_now_s() : arrival_s);
+      send_calibration_updates();
     }
   }
 }
 
 // QoS events into link events. Realtime: at the time they happened. Lockstep: deadlines are
 // not used (time is simulated: CornerSupervisor::tick finds a silent corner), and a lost
-// writer is acted on only while its corner's block is missing (see run()), so a slow machine
-// cannot change the result.
+// writer is acted on only while its corner's block is missing (node::CcuNode::end_lockstep_period),
+// so a slow machine cannot change the result.
 void CcuApp::drain_qos_events(double now_s, bool lockstep) {
   dds::QosEvent e;
-  for (std::size_t i = 0; i < channels_.size(); ++i) {
-    CornerChannel& ch = channels_[i];
-    while (blocks_[i]->take_event(e)) {
-      // A corner that has sent its last block is done: its deadline passing and its writer
-      // leaving are its normal end (they raised link_lost and process_lost on the corners that
-      // finished first while the CCU still waited for another's last block).
-      if (!ch.have_handles || ch.finished) continue;
+  for (std::size_t i = 0; i < node_.channels(); ++i) {
+    while (blocks_[i]->get().take_event(e)) {
       const double t = lockstep ? now_s : std::chrono::duration<double>(e.at - t0_).count();
-      if (e.kind == dds::QosEvent::Kind::DeadlineMissed && e.handle == ch.instance) {
-        ++ch.deadlines_missed;
-        if (!lockstep) core_.on_link_event(ch.slot, faults::LinkEvent::DeadlineMissed, t);
-      } else if ((e.kind == dds::QosEvent::Kind::LivelinessLost || e.kind == dds::QosEvent::Kind::WriterLost) &&
-                 e.handle == ch.writer && ch.writer_alive) {
-        ++ch.liveliness_lost;
-        ch.writer_alive = false;
-        if (!lockstep) core_.on_link_event(ch.slot, faults::LinkEvent::LivelinessLost, t);
-      } else if (e.kind == dds::QosEvent::Kind::LivelinessRecovered && e.handle == ch.writer) {
-        ch.writer_alive = true;
+      if (e.kind == dds::QosEvent::Kind::DeadlineMissed) {
+        if (e.handle == instances_[i]) node_.on_deadline_missed(i, t, lockstep);
+      } else if (e.kind == dds::QosEvent::Kind::LivelinessLost || e.kind == dds::QosEvent::Kind::WriterLost) {
+        node_.on_writer_lost(i, dds::endpoint_id(e.handle), t, lockstep);
+      } else if (e.kind == dds::QosEvent::Kind::LivelinessRecovered) {
+        node_.on_writer_recovered(i, dds::endpoint_id(e.handle));
       }
     }
   }
-  record_detections();
+  node_.record_detections();
 }
 
-void CcuApp::record_detections() {
-  for (auto& ch : channels_) {
-    const faults::FaultMonitor& m = core_.supervisor(ch.slot).monitor();
-    for (std::size_t p = 0; p < ch.seen.size(); ++p) {
-      const faults::Diagnosis& d = m.diagnosis(static_cast<faults::Part>(p));
-      faults::Diagnosis& seen = ch.seen[p];
-      // A finding upgraded later (e.g. actuator_lost -> actuator_not_releasing) is recorded at
-      // the time of the upgrade.
-      if (d.present && (!seen.present || d.detected_s != seen.detected_s || d.finding != seen.finding)) {
-        if (detections_.size() < detections_.capacity()) detections_.push_back({ch.slot, d.finding, d.onset_s, d.finding_s});
-      }
-      seen = d;
-    }
-  }
-}
-
-void CcuApp::after_period(double now_s) {
-  for (auto& ch : channels_) {
-    ch.block_tokens = std::min(CornerChannel::kBlockBurst, ch.block_tokens + CornerChannel::kBlocksPerPeriod);
-  }
-  core_.tick(now_s);
-  record_detections();
-}
-
-bool CcuApp::wait_for_rejoin(CornerChannel& ch, std::uint32_t incarnation, std::string& error) {
+bool CcuApp::wait_for_rejoin(std::size_t i, std::uint32_t incarnation, std::string& error) {
+  const node::CornerChannel& ch = node_.channel(i);
   const bool ok = events_.wait_for(options_.discovery_timeout, [&] {
     drain_health();
     return ch.health_incarnation >= incarnation &&
            (ch.health == msg::HEALTH_STARTING || ch.health == msg::HEALTH_RUNNING);
   });
-  if (ok) ch.writer_alive = true;  // its block is expected from now on
+  if (ok) node_.expect_rejoin(i);  // its block is expected from now on
   if (!ok && !events_.interrupted()) {
-    error = std::string("restarted corner ") + dds::corner_name(ch.corner) + " did not join within " +
+    error = std::string("restarted corner ") + corner_name(ch.corner) + " did not join within " +
             std::to_string(options_.discovery_timeout.count()) + " ms";
   }
   return ok;
@@ -398,10 +164,7 @@ void CcuApp::freeze_for_kill(double at_s) {
   // nothing is sent (not even liveliness), as after a crash; the launcher SIGKILLs us.
   sim_s_ = at_s;
   wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
-  for (auto& ch : channels_) {
-    if (ch.csv != nullptr) std::fflush(ch.csv);
-  }
-  if (periods_csv_ != nullptr) std::fflush(periods_csv_);
+  if (log_ != nullptr) log_->flush();
   if (!options_.out_dir.empty()) write_stats(options_.out_dir + "/ccu.stats");
   ::raise(SIGSTOP);
   // Continued instead of killed (nobody carried the kill out): stop without a word.
@@ -411,11 +174,7 @@ void CcuApp::freeze_for_kill(double at_s) {
 int CcuApp::run(std::string& error) {
   if (!wait_for_corners(error)) return events_.interrupted() ? kExitOk : kExitDiscovery;
   // Initial model: every corner knows the thresholds and initial curve before period 0.
-  for (auto& ch : channels_) {
-    msg::CalibrationState state;
-    dds::to_msg(core_.supervisor(ch.slot).calibrator(), static_cast<std::uint8_t>(ch.slot), 0, 0.0, state);
-    calibration_.write(state);
-  }
+  for (const msg::CalibrationState& s : node_.initial_states()) calibration_.send(s);
   const double T = scenario_.ccu_period_s;
   t0_ = Clock::now();
   int rc = kExitOk;
@@ -426,8 +185,8 @@ int CcuApp::run(std::string& error) {
       if (kill_at_s_ && t_k >= *kill_at_s_ - 1e-9) freeze_for_kill(t_k);
       for (const auto& [step, slot] : restarts_) {
         if (step != k) continue;
-        for (auto& ch : channels_) {
-          if (ch.slot == slot && !wait_for_rejoin(ch, ++expected_incarnation[slot], error)) return kExitPeerLost;
+        for (std::size_t i = 0; i < node_.channels(); ++i) {
+          if (node_.channel(i).slot == slot && !wait_for_rejoin(i, ++expected_incarnation[slot], error)) return kExitPeerLost;
         }
       }
       send_commands(k, false);
@@ -439,11 +198,7 @@ int CcuApp::run(std::string& error) {
         drain_blocks(t_end);
         drain_health();
         drain_qos_events(t_end, true);
-        for (const auto& ch : channels_) {
-          if (ch.health == msg::HEALTH_FAILED) return true;
-          if (ch.next_block <= k && ch.writer_alive) return false;
-        }
-        return true;
+        return node_.period_complete(k);
       };
       const auto give_up = Clock::now() + options_.peer_timeout;
       bool ok = false;
@@ -452,27 +207,19 @@ int CcuApp::run(std::string& error) {
         if (ok || events_.interrupted() || Clock::now() >= give_up) break;
         send_commands(k, false, false);
       }
-      for (auto& ch : channels_) {
-        if (ch.health == msg::HEALTH_FAILED) {
-          error = std::string("corner ") + dds::corner_name(ch.corner) + " reported failure at period " + std::to_string(k);
-          rc = kExitPeerLost;
-        } else if (ch.next_block <= k && !ch.writer_alive) {
-          core_.on_link_event(ch.slot, faults::LinkEvent::LivelinessLost, t_end);
-        }
-      }
-      if (rc != kExitOk) break;
-      if (!ok) {
-        if (events_.interrupted()) break;
-        std::string late;
-        for (const auto& ch : channels_) {
-          if (ch.next_block <= k) late += (late.empty() ? "" : ", ") + std::string(dds::corner_name(ch.corner));
-        }
-        error = "no block for period " + std::to_string(k) + " within " + std::to_string(options_.peer_timeout.count()) +
-                " ms from " + late;
+      if (const std::string failed = node_.end_lockstep_period(k, t_end); !failed.empty()) {
+        error = "corner " + failed + " reported failure at period " + std::to_string(k);
         rc = kExitPeerLost;
         break;
       }
-      after_period(t_end);
+      if (!ok) {
+        if (events_.interrupted()) break;
+        error = "no block for period " + std::to_string(k) + " within " + std::to_string(options_.peer_timeout.count()) +
+                " ms from " + node_.lagging(k);
+        rc = kExitPeerLost;
+        break;
+      }
+      node_.after_period(t_end);
       periods_done_ = k + 1;
     }
   } else {
@@ -490,7 +237,7 @@ int CcuApp::run(std::string& error) {
       });
       if (events_.interrupted()) break;
       const double t_k = static_cast<double>(k) * T;
-      after_period(realtime_now_s());
+      node_.after_period(realtime_now_s());
       periods_done_ = k;
       if (k == periods_) break;
       if (kill_at_s_ && t_k >= *kill_at_s_ - 1e-9) freeze_for_kill(t_k);
@@ -500,22 +247,15 @@ int CcuApp::run(std::string& error) {
     events_.wait_for(std::chrono::milliseconds(500), [&] {
       drain_blocks(0.0);
       drain_qos_events(0.0, false);
-      for (const auto& ch : channels_) {
-        const auto& m = core_.supervisor(ch.slot).monitor();
-        if (!ch.finished && m.ok(faults::Part::Network) && m.ok(faults::Part::Process)) return false;
-      }
-      return true;
+      return node_.all_linked_finished();
     });
-    record_detections();
+    node_.record_detections();
   }
   wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
   sim_s_ = static_cast<double>(periods_done_) * T;
   send_commands(periods_, true);
-  commands_.get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
-  for (auto& ch : channels_) {
-    if (ch.csv != nullptr) std::fflush(ch.csv);
-  }
-  if (periods_csv_ != nullptr) std::fflush(periods_csv_);
+  commands_.get().get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
+  if (log_ != nullptr) log_->flush();
   return rc;
 }
 
@@ -529,25 +269,26 @@ void CcuApp::write_stats(const std::string& file) const {
   w.set("killed_at_s", kill_at_s_ ? sim_s_ : -1.0);
   std::uint64_t deadlines = 0, liveliness = 0, lost = 0, dropped = 0, foreign = 0;
   for (const auto& r : blocks_) {
-    deadlines += r->deadlines_missed();
-    liveliness += r->liveliness_lost();
-    lost += r->samples_lost();
-    dropped += r->events_dropped();
+    deadlines += r->get().deadlines_missed();
+    liveliness += r->get().liveliness_lost();
+    lost += r->get().samples_lost();
+    dropped += r->get().events_dropped();
   }
-  for (const auto& ch : channels_) foreign += ch.foreign_blocks + ch.foreign_health;
+  for (std::size_t i = 0; i < node_.channels(); ++i) foreign += node_.channel(i).foreign_blocks + node_.channel(i).foreign_health;
   w.set("measurement_deadlines_missed", static_cast<unsigned long long>(deadlines));
   w.set("measurement_liveliness_lost", static_cast<unsigned long long>(liveliness));
   w.set("measurement_samples_lost", static_cast<unsigned long long>(lost));
   w.set("qos_events_dropped", static_cast<unsigned long long>(dropped));
   w.set("foreign_corner_samples", static_cast<unsigned long long>(foreign));
-  w.set("unknown_corner_blocks", static_cast<unsigned long long>(unknown_corner_blocks_));
-  w.set("command_write_failures", static_cast<unsigned long long>(commands_.write_failures()));
+  w.set("unknown_corner_blocks", static_cast<unsigned long long>(node_.unknown_corner_blocks()));
+  w.set("command_write_failures", static_cast<unsigned long long>(commands_.get().write_failures()));
   std::string corners;
-  for (const auto& ch : channels_) corners += (corners.empty() ? "" : ",") + std::string(dds::corner_name(ch.corner));
+  for (std::size_t i = 0; i < node_.channels(); ++i) corners += (corners.empty() ? "" : ",") + std::string(corner_name(node_.channel(i).corner));
   w.set("corners", corners);
-  for (const auto& ch : channels_) {
-    const std::string p = std::string(dds::corner_name(ch.corner)) + ".";
-    const faults::CornerSupervisor& sup = core_.supervisor(ch.slot);
+  for (std::size_t i = 0; i < node_.channels(); ++i) {
+    const node::CornerChannel& ch = node_.channel(i);
+    const std::string p = std::string(corner_name(ch.corner)) + ".";
+    const faults::CornerSupervisor& sup = node_.core().supervisor(ch.slot);
     const auto& st = sup.calibrator().stats();
     w.set(p + "blocks_received", static_cast<unsigned long long>(ch.blocks_received));
     w.set(p + "samples_received", static_cast<unsigned long long>(ch.samples_received));
@@ -575,11 +316,12 @@ void CcuApp::write_stats(const std::string& file) const {
     w.set(p + "curve_d", c.d);
   }
   // Every detection in time order of recording: corner, finding, onset, detection time.
-  w.set("detections", static_cast<unsigned long long>(detections_.size()));
-  for (std::size_t i = 0; i < detections_.size(); ++i) {
-    const DetectionRecord& d = detections_[i];
+  const auto& detections = node_.detections();
+  w.set("detections", static_cast<unsigned long long>(detections.size()));
+  for (std::size_t i = 0; i < detections.size(); ++i) {
+    const node::DetectionRecord& d = detections[i];
     const std::string p = "detection." + std::to_string(i) + ".";
-    w.set(p + "corner", std::string(dds::corner_name(static_cast<dds::Corner>(d.slot))));
+    w.set(p + "corner", std::string(corner_name(static_cast<Corner>(d.slot))));
     w.set(p + "finding", std::string(faults::to_string(d.finding)));
     w.set(p + "part", std::string(faults::to_string(faults::part_of(d.finding))));
     w.set(p + "onset_s", d.onset_s);

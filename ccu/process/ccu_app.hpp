@@ -1,7 +1,7 @@
-// The CCU process: the CCU core (one CornerSupervisor per corner: guard, calibrator, fault
-// monitor, reactions; the Redistributor) fed with every sample received over DDS, the DDS QoS
-// events (deadline missed, liveliness lost) as link events, the per-corner commands and
-// calibration states, and the logs.
+// The CCU process: the DDS adapter of the CcuNode (bbw/node/ccu_node.hpp). It moves every block
+// and health message received over DDS into the node, turns the DDS QoS events (deadline missed,
+// liveliness lost) into the node's link events, sends the node's commands and calibration states,
+// runs the clock (lockstep or realtime), and logs through an observer of the node.
 #pragma once
 
 #include <bbw/idl/bbw_msgsPubSubTypes.h>
@@ -23,7 +23,9 @@
 #include "bbw/dds/writer.hpp"
 #include "bbw/faults/schedule.hpp"
 #include "bbw/scenario/scenario.hpp"
-#include "ccu_core.hpp"
+#include "bbw/dds/ports.hpp"
+#include "bbw/node/ccu_node.hpp"
+#include "bbw/node/csv_log.hpp"
 
 namespace bbw::ccu {
 
@@ -46,55 +48,6 @@ struct CcuOptions : dds::ProcessOptions {
   faults::FaultSchedule schedule;
 };
 
-// One detection (a diagnosis confirmed, or confirmed again after it had cleared).
-struct DetectionRecord {
-  std::size_t slot = 0;
-  faults::Finding finding = faults::Finding::None;
-  double onset_s = 0.0;
-  double detected_s = 0.0;
-};
-
-struct CornerChannel {
-  dds::Corner corner;
-  std::size_t slot = 0;
-  std::uint64_t next_block = 0;
-  std::uint64_t next_sample_seq = 1;
-  std::uint32_t incarnation = 0;
-  std::uint64_t blocks_received = 0;
-  std::uint64_t samples_received = 0;
-  std::uint64_t samples_invalid = 0;   // rejected by the sample guard
-  // Received in this corner's partition with another corner id (a corner posing as another,
-  // or a corner id that does not exist): dropped before anything reads them.
-  std::uint64_t foreign_blocks = 0;
-  std::uint64_t foreign_health = 0;
-  // Flood guard: a token bucket of blocks this corner may still have processed (refilled by
-  // kBlocksPerPeriod every CCU period up to kBlockBurst); blocks beyond it are taken and dropped
-  // unread, so a corner sending at many times its rate cannot take the CCU's time from the
-  // others (docs/security.md, "Flooding").
-  static constexpr double kBlocksPerPeriod = 2.0;
-  static constexpr double kBlockBurst = 40.0;
-  double block_tokens = kBlockBurst;
-  std::uint64_t blocks_over_rate = 0;
-  std::uint64_t block_gaps = 0;        // blocks missing or out of order (within an incarnation)
-  std::uint64_t sample_gaps = 0;       // samples missing between consecutive blocks (within one)
-  std::uint64_t rejoins = 0;           // new incarnations seen
-  std::uint64_t command_seq = 0;
-  std::uint64_t calibration_version = 0;
-  std::uint64_t published_fits = 0;
-  std::uint64_t published_restarts = 0;
-  std::uint64_t deadlines_missed = 0;  // DDS deadline-missed events for this corner
-  std::uint64_t liveliness_lost = 0;   // DDS liveliness-lost events for this corner's writer
-  bool finished = false;               // received the last block
-  bool writer_alive = true;            // liveliness of the corner's measurement writer
-  bool have_handles = false;
-  eprosima::fastrtps::rtps::InstanceHandle_t instance;  // the corner's key instance
-  eprosima::fastrtps::rtps::InstanceHandle_t writer;    // the current incarnation's writer
-  int health = -1;
-  std::uint32_t health_incarnation = 0;
-  std::array<faults::Diagnosis, 5> seen{};  // last diagnoses recorded (detection log)
-  std::FILE* csv = nullptr;
-};
-
 class CcuApp {
  public:
   CcuApp(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator,
@@ -109,40 +62,33 @@ class CcuApp {
  private:
   bool wait_for_corners(std::string& error);
   void send_commands(std::uint64_t step, bool stop, bool log = true);
-  void process_block(CornerChannel& ch, const msg::MeasurementBlock& b,
-                     const eprosima::fastdds::dds::SampleInfo& info, double arrival_s);
+  void send_calibration_updates();
   void drain_blocks(double arrival_s);
   void drain_qos_events(double now_s, bool lockstep);
   void drain_health();
-  void after_period(double now_s);
-  void record_detections();
-  void publish_calibration(CornerChannel& ch, double time_s);
-  bool wait_for_rejoin(CornerChannel& ch, std::uint32_t incarnation, std::string& error);
+  bool wait_for_rejoin(std::size_t channel, std::uint32_t incarnation, std::string& error);
   [[noreturn]] void freeze_for_kill(double at_s);
-  CornerChannel* channel(std::uint8_t wire_id);
   double realtime_now_s() const;
 
   const scenario::Scenario& scenario_;
   CcuOptions options_;
   dds::Events& events_;
-  CcuCore core_;
+  node::CcuNode node_;
   std::uint64_t periods_;
-  std::vector<CornerChannel> channels_;
 
   dds::Participant participant_;
-  // One measurement and one health reader per corner (same index as channels_), each in that
-  // corner's partition (corner_FL, ...): DDS Security lets a corner write only there.
-  using BlockReader = dds::Reader<msg::MeasurementBlockPubSubType>;
-  using HealthReader = dds::Reader<msg::CornerHealthPubSubType>;
-  std::vector<std::unique_ptr<BlockReader>> blocks_;
-  std::vector<std::unique_ptr<HealthReader>> health_;
-  dds::Writer<msg::ClampCommandPubSubType> commands_;
-  dds::Writer<msg::CalibrationStatePubSubType> calibration_;
+  // One measurement and one health reader per corner (same index as the node's channels), each
+  // in that corner's partition (corner_FL, ...): DDS Security lets a corner write only there.
+  using BlockInlet = dds::DdsInlet<msg::MeasurementBlockPubSubType>;
+  using HealthInlet = dds::DdsInlet<msg::CornerHealthPubSubType>;
+  std::vector<std::unique_ptr<BlockInlet>> blocks_;
+  std::vector<std::unique_ptr<HealthInlet>> health_;
+  std::vector<eprosima::fastrtps::rtps::InstanceHandle_t> instances_;  // each corner's key instance
+  dds::DdsOutlet<msg::ClampCommandPubSubType> commands_;
+  dds::DdsOutlet<msg::CalibrationStatePubSubType> calibration_;
 
   msg::MeasurementBlock block_;
-  std::vector<DetectionRecord> detections_;
-  std::FILE* periods_csv_ = nullptr;
-  std::uint64_t unknown_corner_blocks_ = 0;
+  std::unique_ptr<node::CcuCsvLog> log_;
   std::chrono::steady_clock::time_point t0_{};
   double wall_s_ = 0.0;
   double sim_s_ = 0.0;

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "bbw/calibration/maxwell_slip.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/launch/stats_file.hpp"
+#include "bbw/node/csv_log.hpp"
 
 namespace bbw::corner_process {
 
@@ -18,28 +18,16 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::uint64_t steps_per_period(const scenario::Scenario& s) {
-  const double ratio = s.ccu_period_s / s.plant_dt_s;
-  const double rounded = std::round(ratio);
-  if (std::fabs(ratio - rounded) > 1e-9 || rounded < 1.0 || rounded > msg::MAX_BLOCK_SAMPLES) {
-    throw std::invalid_argument(s.file + ": ccu_period_s / plant_dt_s must be an integer in [1, " +
-                                std::to_string(msg::MAX_BLOCK_SAMPLES) + "], got " + std::to_string(ratio));
-  }
-  return static_cast<std::uint64_t>(rounded);
-}
-
-const scenario::Scenario& validated(const scenario::Scenario& s, const CornerOptions& o) {
-  if (o.scenario_index >= s.corners.size()) throw std::invalid_argument("corner index out of range");
-  if (s.corners[o.scenario_index].name != dds::corner_name(o.corner)) {
-    throw std::invalid_argument("scenario corner " + std::to_string(o.scenario_index) + " is '" +
-                                s.corners[o.scenario_index].name + "', not " + dds::corner_name(o.corner));
-  }
-  steps_per_period(s);
-  if (!(o.resume_at_s >= 0.0 && o.resume_at_s < s.duration_s)) {
-    throw std::invalid_argument("resume time " + std::to_string(o.resume_at_s) + " s is outside the scenario (0 to " +
-                                std::to_string(s.duration_s) + " s)");
-  }
-  return s;
+node::CornerNodeOptions node_options(const CornerOptions& o) {
+  node::CornerNodeOptions n;
+  n.corner = o.corner;
+  n.scenario_index = o.scenario_index;
+  n.lockstep = o.mode == ClockMode::Lockstep;
+  n.schedule = o.schedule;
+  n.watchdog = o.watchdog;
+  n.incarnation = o.incarnation;
+  n.resume_at_s = o.resume_at_s;
+  return n;
 }
 
 dds::ParticipantOptions named(dds::ParticipantOptions p, dds::Corner c) {
@@ -47,17 +35,13 @@ dds::ParticipantOptions named(dds::ParticipantOptions p, dds::Corner c) {
   return p;
 }
 
-faults::Target target_of(dds::Corner c) { return static_cast<faults::Target>(dds::corner_index(c)); }
-
 }  // namespace
 
 CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& options, dds::Events& events)
-    : scenario_(validated(scenario, options)),
+    : scenario_(scenario),
       options_(options),
       events_(events),
-      sim_(scenario, options.scenario_index),
-      steps_per_period_(steps_per_period(scenario)),
-      periods_(static_cast<std::uint64_t>(std::ceil(scenario.duration_s / scenario.ccu_period_s - 1e-9))),
+      node_(scenario, node_options(options)),
       participant_(named(options.participant, options.corner)),
       // Measurements and health in the corner's own partition (corner_FL, ...), secure or not:
       // the permissions grant a corner only that one (docs/security.md).
@@ -68,202 +52,66 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
               dds::Partition{security::corner_partition(static_cast<int>(dds::corner_index(options.corner)))}),
       // No DDS content filter on these topics: Fast DDS 2.9 evaluates DDS-SQL filters on the
       // writer by deserialising into DynamicData, which throws and catches internally on every
-      // sample and made the CCU's command writes its largest cost. Corners drop the other
-      // corners' samples here instead (4 commands per period, a few bytes each).
+      // sample and made the CCU's command writes its largest cost. The node drops the other
+      // corners' samples instead (4 commands per period, a few bytes each).
       commands_(participant_, dds::kCommandTopic,
                 dds::profiles_for(options.mode == ClockMode::Lockstep).command_reader, events),
-      calibration_(participant_, dds::kCalibrationTopic, "state_reader", events),
-      my_id_(static_cast<std::uint8_t>(dds::corner_index(options.corner))),
-      injector_(options.schedule, target_of(options.corner),
-                scenario::corner_seed(scenario.seed + 7777, options.scenario_index)),
-      link_(options.schedule, target_of(options.corner)),
-      watchdog_(options.watchdog),
-      resume_step_(static_cast<std::uint64_t>(std::ceil(options.resume_at_s / scenario.ccu_period_s - 1e-9))) {
-  block_.corner_id(my_id_);
-  block_.incarnation(options.incarnation);
-  block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
+      calibration_(participant_, dds::kCalibrationTopic, "state_reader", events) {
   if (!options.periods_log.empty()) {
-    // A restarted process appends to its predecessor's log.
-    periods_csv_ = std::fopen(options.periods_log.c_str(), options.incarnation == 0 ? "w" : "a");
-    if (periods_csv_ == nullptr) throw std::runtime_error(options.periods_log + ": cannot write");
-    if (options.incarnation == 0) std::fputs("time_s,force_true_kN,applied_kN,watchdog_mode,incarnation\n", periods_csv_);
+    periods_log_ = std::make_unique<node::CornerPeriodsLog>(options.periods_log, options.incarnation);
+    node_.set_observer(periods_log_.get());
   }
 }
 
-CornerApp::~CornerApp() {
-  if (periods_csv_ != nullptr) std::fclose(periods_csv_);
-}
+CornerApp::~CornerApp() = default;
 
-void CornerApp::publish_health(std::uint8_t status) {
-  msg::CornerHealth h;
-  h.corner_id(my_id_);
-  h.status(status);
-  h.samples_published(stats_.samples_published);
-  h.blocks_published(stats_.blocks_published);
-  h.commands_received(stats_.commands_received);
-  h.commands_applied(stats_.commands_applied);
-  h.command_seq_gaps(stats_.command_seq_gaps);
-  h.overruns(stats_.overruns);
-  h.max_jitter_s(stats_.max_jitter_s);
-  h.time_s(sim_.time_s());
-  h.incarnation(options_.incarnation);
-  h.resume_step(resume_step_);
-  health_.write(h);
-}
+void CornerApp::publish_health(std::uint8_t status) { health_.send(node_.health(status)); }
 
 bool CornerApp::wait_for_ccu(std::string& error) {
   const auto timeout = options_.match_timeout.count() > 0 ? options_.match_timeout : options_.discovery_timeout;
   const bool ok = events_.wait_for(timeout, [&] {
-    return blocks_.matched() >= 1 && commands_.matched() >= 1 && calibration_.matched() >= 1 &&
-           health_.matched() >= 1;
+    return blocks_.peers() >= 1 && commands_.peers() >= 1 && calibration_.peers() >= 1 && health_.peers() >= 1;
   });
   matched_ccu_ = ok;
   if (!ok && !events_.interrupted()) {
     error = std::string("CCU not discovered within ") +
             std::to_string(timeout.count()) + " ms (measurement readers matched: " +
-            std::to_string(blocks_.matched()) + ", command writers matched: " +
-            std::to_string(commands_.matched()) + ")";
+            std::to_string(blocks_.peers()) + ", command writers matched: " +
+            std::to_string(commands_.peers()) + ")";
   }
   return ok;
 }
 
 double CornerApp::sim_now_s() const {
-  return static_cast<double>(resume_step_) * scenario_.ccu_period_s +
+  return static_cast<double>(node_.resume_step()) * scenario_.ccu_period_s +
          std::chrono::duration<double>(Clock::now() - t0_).count();
 }
 
 bool CornerApp::ccu_gone() const {
-  return (commands_.liveliness_lost() > 0 && commands_.alive_writers() == 0) || commands_.matched() == 0;
+  return (commands_.get().liveliness_lost() > 0 && commands_.get().alive_writers() == 0) || commands_.peers() == 0;
 }
 
-// Takes every waiting command and calibration state; keeps the newest command.
+// Takes every waiting command and calibration state into the node.
 void CornerApp::drain_inputs() {
   msg::ClampCommand cmd;
-  while (commands_.take(cmd)) {
-    if (cmd.corner_id() != my_id_) continue;
-    ++stats_.commands_received;
-    if (last_command_seq_ && cmd.seq() != *last_command_seq_ + 1) {
-      stats_.command_seq_gaps += cmd.seq() > *last_command_seq_ ? cmd.seq() - *last_command_seq_ - 1 : 1;
-    }
-    last_command_seq_ = cmd.seq();
-    if (cmd.step() < resume_step_ && !cmd.stop()) continue;  // a restarted corner joins at its resume step
-    if (!have_command_ || cmd.step() >= latest_command_.step()) {
-      latest_command_ = cmd;
-      have_command_ = true;
-      if (cmd.valid() && (cmd.mode() == msg::MODE_FORCE || cmd.mode() == msg::MODE_RELEASE)) {
-        // Lockstep (and the start command): the command belongs to its period's start.
-        // Realtime: to its arrival on this corner's clock.
-        const double at = options_.mode == ClockMode::Lockstep || !started_ ? cmd.time_s() : sim_now_s();
-        watchdog_.on_command(at, cmd.mode() == msg::MODE_FORCE ? cmd.clamp_force_kN() : 0.0);
-      }
-    }
-  }
+  while (commands_.take(cmd)) node_.on_command(cmd, started_ ? sim_now_s() : 0.0);
   msg::CalibrationState state;
-  while (calibration_.take(state)) {
-    if (state.corner_id() != my_id_) continue;
-    if (state.version() < model_.version && friction_.started()) continue;  // stale
-    dds::CalibrationModel m;
-    if (!dds::from_msg(state, m)) {
-      ++stats_.calibrations_rejected;
-      continue;
-    }
-    if (!model_.friction.delta_rev.empty() && m.friction.delta_rev != model_.friction.delta_rev) {
-      ++stats_.calibrations_rejected;  // thresholds are fixed by the calibrator config
-      continue;
-    }
-    model_ = std::move(m);
-    ++stats_.calibrations_applied;
-  }
+  while (calibration_.take(state)) node_.on_calibration(state);
 }
 
 void CornerApp::simulate_period(std::uint64_t k) {
-  const double dt = scenario_.plant_dt_s;
-  scenario::ExternalInputs ext;
-  const bool valid = have_command_ && latest_command_.valid();
-  if (valid && !ccu_lost_) ++stats_.commands_applied;
-  const bool calibrated = model_.version > 0 && latest_command_.use_friction_comp();
-  if (calibrated) ext.curve = model_.curve;
-  // A CCU fault reaction: the feedback to use instead of the corner's own.
-  if (have_command_ && latest_command_.feedback_override() == msg::FEEDBACK_CURVE) {
-    ext.feedback = corner_unit::ForceFeedback::Curve;
-    ext.curve = scenario::CurveEstimate{latest_command_.override_curve_a_kN_per_rev3(),
-                                        latest_command_.override_curve_b_kN_per_rev2(),
-                                        latest_command_.override_curve_c_kN_per_rev(),
-                                        latest_command_.override_curve_d_kN()};
-  } else if (have_command_ && latest_command_.feedback_override() == msg::FEEDBACK_LOAD_CELL) {
-    ext.feedback = corner_unit::ForceFeedback::LoadCell;
-  }
-
-  block_.block_seq(k);
-  block_.period_start_s(sim_.time_s());
-  block_.samples().clear();
-  faults::WatchdogOutput w;
-  msg::MeasurementSample m;
-  for (std::uint64_t i = 0; i < steps_per_period_; ++i) {
-    const double t_end = sim_.time_s() + dt;
-    // Force mode: the CCU's command through the watchdog (hold, then the default, if it is lost).
-    w = watchdog_.at(t_end);
-    if (w.force_command_kN) ext.force_command_kN = w.force_command_kN;
-    if (w.mode == faults::WatchdogMode::Holding && stats_.ccu_lost_s < 0.0) stats_.ccu_lost_s = t_end;
-    if (w.mode == faults::WatchdogMode::Default && stats_.default_force_s < 0.0) stats_.default_force_s = t_end;
-    // Friction the load cell is believed to hold, from the CCU's model (Maxwell-slip elements
-    // and the calibrator's optional effect terms) and this corner's own element and play states
-    // (they depend only on the position history).
-    const double x = sim_.last().position_rev;
-    double friction = 0.0;
-    if (!model_.friction.delta_rev.empty()) {
-      if (!friction_.started()) friction_.reset(model_.friction.delta_rev.size(), x);
-      friction = friction_.step_load_cell_excess(model_.friction, x, sim_.last().speed_rev_s, sim_.last().temperature_C);
-    }
-    ext.friction_estimate_kN = calibrated ? friction : 0.0;
-    injector_.prepare(ext, t_end);
-    const auto& s = sim_.step(dt, ext);
-    dds::to_msg(s, calibrated && sim_.feedback() == corner_unit::ForceFeedback::Compensated, m);
-    // Network faults on the way out: silence drops the sample, a delay holds it back (order kept).
-    if (link_.silenced(s.time_s)) {
-      ++stats_.samples_suppressed;
-    } else if (const double d = link_.delay_s(s.time_s); d > 0.0 || outbox_.size() > 0) {
-      if (d > 0.0) ++stats_.samples_delayed;
-      if (!outbox_.push(s.time_s + d, m)) ++stats_.samples_suppressed;
-    } else if (block_.samples().size() < msg::MAX_BLOCK_SAMPLES) {
-      block_.samples().push_back(m);
-    }
-  }
-  while (block_.samples().size() < msg::MAX_BLOCK_SAMPLES) {
-    auto due = outbox_.pop_due(sim_.time_s() + 1e-9);
-    if (!due) break;
-    block_.samples().push_back(*due);
-  }
-  block_.first_sample_seq(block_.samples().empty() ? 0 : block_.samples().front().seq());
-  // Lockstep: an empty block still tells the CCU that this period is done (time is simulated).
-  // Realtime: nothing to send is nothing sent.
-  if (options_.mode == ClockMode::Lockstep || !block_.samples().empty()) {
-    if (blocks_.write(block_)) {
-      ++stats_.blocks_published;
-      stats_.samples_published += block_.samples().size();
-      if (ccu_lost_ || w.mode == faults::WatchdogMode::Holding || w.mode == faults::WatchdogMode::Default) {
-        stats_.samples_without_ccu += block_.samples().size();
-      }
-    } else {
-      ++stats_.write_failures;
-    }
-  }
-  ++stats_.periods;
-  if (periods_csv_ != nullptr) {
-    std::fprintf(periods_csv_, "%.6f,%.9g,%.9g,%d,%u\n", sim_.time_s(), sim_.last().force_true_kN,
-                 ext.force_command_kN ? *ext.force_command_kN : std::nan(""), static_cast<int>(w.mode),
-                 options_.incarnation);
-  }
+  if (const msg::MeasurementBlock* b = node_.simulate_period(k)) node_.block_sent(blocks_.send(*b));
 }
 
 void CornerApp::finish_stats(Clock::time_point wall0) {
-  if (stats_.periods > 0) stats_.mean_jitter_s = jitter_sum_s_ / static_cast<double>(stats_.periods);
-  stats_.command_deadlines_missed = commands_.deadlines_missed();
-  stats_.write_failures += blocks_.write_failures();
-  stats_.samples_in_flight = outbox_.size();
-  stats_.first_step = resume_step_;
-  stats_.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
-  if (periods_csv_ != nullptr) std::fflush(periods_csv_);
+  CornerStats& s = node_.stats();
+  if (s.periods > 0) s.mean_jitter_s = jitter_sum_s_ / static_cast<double>(s.periods);
+  const std::uint64_t failures_before = s.write_failures;
+  node_.finish(0, commands_.get().deadlines_missed());
+  // write_failures: the node counts refused sends; the writer's own count is the same events.
+  s.write_failures = failures_before;
+  s.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
+  if (periods_log_ != nullptr) periods_log_->flush();
 }
 
 void CornerApp::freeze_for_kill() {
@@ -288,34 +136,33 @@ int CornerApp::run(std::string& error) {
       publish_health(msg::HEALTH_STARTING);
       republish = Clock::now() + std::chrono::milliseconds(200);
     }
-    return have_command_;
+    return node_.have_command();
   });
   if (!started) {
     if (events_.interrupted()) return kExitOk;
     error = "no start command from the CCU within " + std::to_string(options_.discovery_timeout.count()) + " ms";
     return kExitPeerLost;
   }
-  const std::uint64_t first = std::max(resume_step_, latest_command_.step());
-  resume_step_ = first;
-  if (first > 0) sim_.start_at(static_cast<double>(first) * scenario_.ccu_period_s);
+  const std::uint64_t first = node_.start();
   publish_health(msg::HEALTH_RUNNING);
 
   const auto period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(scenario_.ccu_period_s));
   t0_ = Clock::now();
   started_ = true;
-  for (std::uint64_t k = first; k < periods_; ++k) {
-    if (options_.process_faults && link_.killed(sim_.time_s() + scenario_.plant_dt_s)) {
+  CornerStats& stats = node_.stats();
+  for (std::uint64_t k = first; k < node_.periods(); ++k) {
+    if (options_.process_faults && node_.kill_due()) {
       finish_stats(wall0);
       freeze_for_kill();
     }
     if (options_.mode == ClockMode::Lockstep) {
-      if (!ccu_lost_) {
+      if (!node_.ccu_lost()) {
         // The command for period k is the grant to simulate it. Without a CCU (its command
         // writer lost its liveliness) the corner runs on alone under its watchdog.
         const bool granted = events_.wait_for(options_.peer_timeout, [&] {
           drain_inputs();
-          return latest_command_.step() >= k || latest_command_.stop() || ccu_gone();
+          return node_.granted(k) || ccu_gone();
         });
         if (events_.interrupted()) break;
         if (!granted) {
@@ -324,8 +171,8 @@ int CornerApp::run(std::string& error) {
           publish_health(msg::HEALTH_FAILED);
           return kExitPeerLost;
         }
-        if (latest_command_.stop()) break;
-        if (latest_command_.step() < k) ccu_lost_ = true;  // only ccu_gone() ends the wait without a grant
+        if (node_.latest_command().stop()) break;
+        if (!node_.granted(k)) node_.set_ccu_lost();  // only ccu_gone() ends the wait without a grant
       }
     } else {
       // Pace on the wall clock: period k starts at t0 + (k - first) * period.
@@ -334,27 +181,26 @@ int CornerApp::run(std::string& error) {
       if (events_.interrupted()) break;
       const double late_s = std::chrono::duration<double>(Clock::now() - wake).count();
       jitter_sum_s_ += late_s;
-      if (late_s > stats_.max_jitter_s) stats_.max_jitter_s = late_s;
-      if (late_s > scenario_.ccu_period_s) ++stats_.overruns;
+      if (late_s > stats.max_jitter_s) stats.max_jitter_s = late_s;
+      if (late_s > scenario_.ccu_period_s) ++stats.overruns;
       drain_inputs();
-      if (latest_command_.stop()) break;
+      if (node_.latest_command().stop()) break;
     }
     simulate_period(k);
   }
   finish_stats(wall0);
   // Deliver everything before the writer goes away (nobody acknowledges without a CCU).
-  const bool alone = ccu_lost_ || ccu_gone() || watchdog_.at(sim_.time_s()).mode == faults::WatchdogMode::Holding ||
-                     watchdog_.at(sim_.time_s()).mode == faults::WatchdogMode::Default;
+  const bool alone = node_.alone() || ccu_gone();
   const eprosima::fastrtps::Duration_t ack(alone ? 0 : 2, alone ? 100000000 : 0);
-  blocks_.get().wait_for_acknowledgments(ack);
+  blocks_.get().get().wait_for_acknowledgments(ack);
   publish_health(events_.interrupted() ? msg::HEALTH_FAILED : msg::HEALTH_FINISHED);
-  health_.get().wait_for_acknowledgments(ack);
-  stats_.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
+  health_.get().get().wait_for_acknowledgments(ack);
+  stats.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   return kExitOk;
 }
 
 void CornerApp::write_stats(const std::string& file) const {
-  const CornerStats& s = stats_;
+  const CornerStats& s = node_.stats();
   launch::StatsWriter w;
   w.set("corner", std::string(dds::corner_name(options_.corner)));
   w.set("incarnation", static_cast<unsigned long long>(options_.incarnation));

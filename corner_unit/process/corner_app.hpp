@@ -1,11 +1,12 @@
-// The corner process: one e-caliper (CornerSim) at the DDS edge. Owns its DDS entities (RAII;
-// construction throws DdsError), converts through bbw/dds/convert.hpp, reads the clock only to
-// pace realtime runs.
+// The corner process: the DDS adapter of one CornerNode (bbw/node/corner_node.hpp). Owns its DDS
+// entities (RAII; construction throws DdsError), moves messages between them and the node, reads
+// the clock only to pace realtime runs, and logs the node's periods (an observer).
 #pragma once
 
 #include <bbw/idl/bbw_msgsPubSubTypes.h>
 
 #include <chrono>
+#include <memory>
 #include <cstdio>
 #include <cstdint>
 #include <optional>
@@ -25,6 +26,9 @@
 #include "bbw/faults/schedule.hpp"
 #include "bbw/scenario/corner_sim.hpp"
 #include "bbw/scenario/scenario.hpp"
+#include "bbw/dds/ports.hpp"
+#include "bbw/node/corner_node.hpp"
+#include "bbw/node/csv_log.hpp"
 
 namespace bbw::corner_process {
 
@@ -62,29 +66,7 @@ using dds::kExitPeerLost;
 using dds::kExitRuntime;
 using dds::kExitUsage;
 
-struct CornerStats {
-  std::uint64_t periods = 0;
-  std::uint64_t samples_published = 0;
-  std::uint64_t blocks_published = 0;
-  std::uint64_t write_failures = 0;
-  std::uint64_t commands_received = 0;
-  std::uint64_t commands_applied = 0;
-  std::uint64_t command_seq_gaps = 0;
-  std::uint64_t calibrations_applied = 0;
-  std::uint64_t calibrations_rejected = 0;
-  std::uint64_t overruns = 0;          // realtime: started a period more than one period late
-  double max_jitter_s = 0.0;           // realtime: largest wake-up lateness
-  double mean_jitter_s = 0.0;
-  std::uint64_t command_deadlines_missed = 0;
-  std::uint64_t samples_suppressed = 0;  // not sent: injected network silence
-  std::uint64_t samples_delayed = 0;     // sent late: injected network delay
-  std::uint64_t samples_in_flight = 0;   // still held back by a delay at the end
-  std::uint64_t samples_without_ccu = 0; // published while the CCU was lost (nobody to receive them)
-  double ccu_lost_s = -1.0;              // simulated time the watchdog found the CCU lost (-1: never)
-  double default_force_s = -1.0;         // ... and went to the default clamp force
-  std::uint64_t first_step = 0;          // the period this incarnation started at
-  double wall_s = 0.0;
-};
+using CornerStats = node::CornerStats;
 
 class CornerApp {
  public:
@@ -97,7 +79,7 @@ class CornerApp {
   // Runs to the end of the scenario (or a stop command, or an interrupt). Returns an ExitCode;
   // `error` explains a non-zero result.
   int run(std::string& error);
-  const CornerStats& stats() const { return stats_; }
+  const CornerStats& stats() const { return node_.stats(); }
   bool matched_ccu() const { return matched_ccu_; }  // the CCU's endpoints matched at least once
   void write_stats(const std::string& file) const;  // key=value (bbw/launch/stats_file.hpp)
 
@@ -114,36 +96,19 @@ class CornerApp {
   const scenario::Scenario& scenario_;
   CornerOptions options_;
   dds::Events& events_;
-  scenario::CornerSim sim_;
-  std::uint64_t steps_per_period_;
-  std::uint64_t periods_;
+  node::CornerNode node_;
 
   dds::Participant participant_;
-  dds::Writer<msg::MeasurementBlockPubSubType> blocks_;
-  dds::Writer<msg::CornerHealthPubSubType> health_;
-  dds::Reader<msg::ClampCommandPubSubType> commands_;
-  dds::Reader<msg::CalibrationStatePubSubType> calibration_;
-  std::uint8_t my_id_;
+  dds::DdsOutlet<msg::MeasurementBlockPubSubType> blocks_;
+  dds::DdsOutlet<msg::CornerHealthPubSubType> health_;
+  dds::DdsInlet<msg::ClampCommandPubSubType> commands_;
+  dds::DdsInlet<msg::CalibrationStatePubSubType> calibration_;
 
-  faults::FaultInjector injector_;
-  faults::LinkFaults link_;
-  faults::CcuWatchdog watchdog_;
-  faults::DelayQueue<msg::MeasurementSample, 1024> outbox_;
-  std::uint64_t resume_step_ = 0;
-  std::chrono::steady_clock::time_point t0_{};  // realtime: wall time of period resume_step_
-  std::FILE* periods_csv_ = nullptr;
-  bool ccu_lost_ = false;   // lockstep: the corner runs on alone
+  std::chrono::steady_clock::time_point t0_{};  // realtime: wall time of the first period
+  std::unique_ptr<node::CornerPeriodsLog> periods_log_;
   bool started_ = false;
   bool matched_ccu_ = false;
   double jitter_sum_s_ = 0.0;
-
-  msg::MeasurementBlock block_;
-  msg::ClampCommand latest_command_;
-  bool have_command_ = false;
-  std::optional<std::uint64_t> last_command_seq_;
-  dds::CalibrationModel model_;
-  calibration::FrictionTracker friction_;  // element and play states of the CCU's friction model
-  CornerStats stats_;
 };
 
 }  // namespace bbw::corner_process

@@ -10,7 +10,7 @@
 #include "alloc_counter.hpp"
 #include "bbw/faults/injector.hpp"
 #include "bbw/scenario/corner_sim.hpp"
-#include "ccu_core.hpp"
+#include "bbw/node/ccu_core.hpp"
 #include "closed_loop.hpp"
 
 using namespace bbw;

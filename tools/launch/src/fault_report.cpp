@@ -7,7 +7,7 @@
 #include "bbw/faults/fault_monitor.hpp"
 #include "bbw/faults/outcome.hpp"
 #include "bbw/launch/stats_file.hpp"
-#include "command_plan.hpp"
+#include "bbw/node/command_plan.hpp"
 
 namespace bbw::launch {
 

@@ -16,7 +16,7 @@
 #include "bbw/faults/fault_monitor.hpp"
 #include "bbw/faults/redistributor.hpp"
 #include "bbw/scenario/scenario.hpp"
-#include "command_plan.hpp"
+#include "bbw/node/command_plan.hpp"
 
 namespace bbw::ccu {
 

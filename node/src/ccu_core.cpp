@@ -1,4 +1,4 @@
-#include "ccu_core.hpp"
+#include "bbw/node/ccu_core.hpp"
 
 #include <cmath>
 #include <limits>

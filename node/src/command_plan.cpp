@@ -1,4 +1,4 @@
-#include "command_plan.hpp"
+#include "bbw/node/command_plan.hpp"
 
 #include <stdexcept>
 
