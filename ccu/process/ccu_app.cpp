@@ -74,7 +74,7 @@ CcuApp::~CcuApp() {
 double CcuApp::realtime_now_s() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
 
 void CcuApp::drain_health() {
-  msg::CornerHealth h;
+  msg::CornerHealth& h = health_in_;  // a member: a message's default constructor re-registers its TypeObject
   for (std::size_t i = 0; i < node_.channels(); ++i) {
     while (health_[i]->take(h)) node_.on_health(i, h);
   }
@@ -107,7 +107,7 @@ void CcuApp::send_commands(std::uint64_t step, bool stop, bool log) {
 }
 
 void CcuApp::send_calibration_updates() {
-  for (const msg::CalibrationState& s : node_.calibration_updates()) calibration_.send(s);
+  for (const msg::CalibrationState* s : node_.calibration_updates()) calibration_.send(*s);
   node_.clear_calibration_updates();
 }
 
@@ -181,7 +181,7 @@ int CcuApp::run(std::string& error) {
   std::uint32_t expected_incarnation[kSlots] = {};
   if (options_.mode == ClockMode::Lockstep) {
     for (std::uint64_t k = 0; k < periods_ && !events_.interrupted(); ++k) {
-      const double t_k = static_cast<double>(k) * T;
+      const double t_k = node_.period_start_s(k);
       if (kill_at_s_ && t_k >= *kill_at_s_ - 1e-9) freeze_for_kill(t_k);
       for (const auto& [step, slot] : restarts_) {
         if (step != k) continue;
@@ -190,7 +190,7 @@ int CcuApp::run(std::string& error) {
         }
       }
       send_commands(k, false);
-      const double t_end = t_k + T;
+      const double t_end = node_.period_end_s(k);
       // Wait until every corner's block k has arrived, or its writer is gone (a dead process).
       // A command is re-sent every 200 ms without progress: a corner that has just (re)joined
       // may have matched our writer only after it was sent.

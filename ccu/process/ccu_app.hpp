@@ -88,6 +88,7 @@ class CcuApp {
   dds::DdsOutlet<msg::CalibrationStatePubSubType> calibration_;
 
   msg::MeasurementBlock block_;
+  msg::CornerHealth health_in_;
   std::unique_ptr<node::CcuCsvLog> log_;
   std::chrono::steady_clock::time_point t0_{};
   double wall_s_ = 0.0;

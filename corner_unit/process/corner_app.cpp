@@ -93,10 +93,9 @@ bool CornerApp::ccu_gone() const {
 
 // Takes every waiting command and calibration state into the node.
 void CornerApp::drain_inputs() {
-  msg::ClampCommand cmd;
-  while (commands_.take(cmd)) node_.on_command(cmd, started_ ? sim_now_s() : 0.0);
-  msg::CalibrationState state;
-  while (calibration_.take(state)) node_.on_calibration(state);
+  // Members, not locals: a message's default constructor re-registers its TypeObject.
+  while (commands_.take(command_in_)) node_.on_command(command_in_, started_ ? sim_now_s() : 0.0);
+  while (calibration_.take(state_in_)) node_.on_calibration(state_in_);
 }
 
 void CornerApp::simulate_period(std::uint64_t k) {

@@ -109,6 +109,8 @@ class CornerApp {
   bool started_ = false;
   bool matched_ccu_ = false;
   double jitter_sum_s_ = 0.0;
+  msg::ClampCommand command_in_;
+  msg::CalibrationState state_in_;
 };
 
 }  // namespace bbw::corner_process

@@ -53,8 +53,13 @@ CcuNode::CcuNode(const scenario::Scenario& scenario, const calibration::Calibrat
       friction_feedback_(friction_feedback),
       periods_(periods_of(scenario)),
       channels_(make_channels(scenario, barrier_)) {
-  commands_.reserve(channels_.size());
-  updates_.reserve(channels_.size() * 4);
+  commands_.resize(channels_.size());
+  states_.resize(channels_.size());
+  for (auto& s : states_) {
+    s.friction_delta_rev().reserve(msg::MAX_FRICTION_ELEMENTS);
+    s.friction_stiffness_kN_per_rev().reserve(msg::MAX_FRICTION_ELEMENTS);
+  }
+  updates_.reserve(channels_.size());
   detections_.reserve(256);
 }
 
@@ -81,10 +86,12 @@ const std::vector<msg::ClampCommand>& CcuNode::commands(std::uint64_t step, bool
   const double t = static_cast<double>(step) * scenario_.ccu_period_s;
   const auto& plans = core_.plan(t);
   double total = 0.0;
-  commands_.clear();
-  for (auto& ch : channels_) {
+  // Overwritten in place, every field each time: constructing a message re-registers the
+  // generated TypeObject (a map search under a lock), the CCU's largest cost per period.
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    CornerChannel& ch = channels_[i];
     const CornerPlan& p = plans[ch.slot];
-    msg::ClampCommand& c = commands_.emplace_back();
+    msg::ClampCommand& c = commands_[i];
     c.corner_id(static_cast<std::uint8_t>(ch.slot));
     c.seq(ch.command_seq++);
     c.step(step);
@@ -94,6 +101,7 @@ const std::vector<msg::ClampCommand>& CcuNode::commands(std::uint64_t step, bool
     c.valid(!stop);
     c.use_friction_comp(friction_feedback_);
     c.calibration_version(ch.calibration_version);
+    c.friction_estimate_kN(ch.last_friction_kN);
     c.stop(stop);
     c.feedback_override(feedback_code(p.feedback));
     c.override_curve_a_kN_per_rev3(p.curve.a);
@@ -124,8 +132,9 @@ void CcuNode::publish_calibration(CornerChannel& ch, double time_s) {
   ch.published_fits = fits;
   ch.published_restarts = restarts;
   ++ch.calibration_version;
-  dds::to_msg(sup.calibrator(), static_cast<std::uint8_t>(ch.slot), ch.calibration_version, time_s,
-              updates_.emplace_back());
+  msg::CalibrationState& state = states_[static_cast<std::size_t>(&ch - channels_.data())];
+  dds::to_msg(sup.calibrator(), static_cast<std::uint8_t>(ch.slot), ch.calibration_version, time_s, state);
+  if (std::find(updates_.begin(), updates_.end(), &state) == updates_.end()) updates_.push_back(&state);
 }
 
 void CcuNode::on_block(std::size_t i, const msg::MeasurementBlock& b, transport::EndpointId writer, double arrival_s) {
@@ -171,6 +180,7 @@ void CcuNode::on_block(std::size_t i, const msg::MeasurementBlock& b, transport:
     const SampleOutcome& o = core_.on_sample(ch.slot, r, arrival_s);
     const bool accepted = core_.supervisor(ch.slot).guard().rejected() == rejected_before;
     if (!accepted) ++ch.samples_invalid;
+    if (o.valid && o.from_calibrator) ch.last_friction_kN = o.friction_kN;
     if (observer_ != nullptr) observer_->on_sample(ch, b.block_seq(), s, o, core_.supervisor(ch.slot).view(), accepted);
   }
   if (b.block_seq() + 1 >= periods_) ch.finished = true;

@@ -55,6 +55,10 @@ CornerNode::CornerNode(const scenario::Scenario& scenario, const CornerNodeOptio
   block_.corner_id(my_id_);
   block_.incarnation(options.incarnation);
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
+  for (dds::CalibrationModel* m : {&model_, &candidate_}) {
+    m->friction.delta_rev.reserve(msg::MAX_FRICTION_ELEMENTS);
+    m->friction.stiffness_kN_per_rev.reserve(msg::MAX_FRICTION_ELEMENTS);
+  }
 }
 
 msg::CornerHealth CornerNode::health(std::uint8_t status) const {
@@ -97,16 +101,16 @@ void CornerNode::on_command(const msg::ClampCommand& cmd, double arrival_s) {
 void CornerNode::on_calibration(const msg::CalibrationState& state) {
   if (state.corner_id() != my_id_) return;
   if (state.version() < model_.version && friction_.started()) return;  // stale
-  dds::CalibrationModel m;
-  if (!dds::from_msg(state, m)) {
+  // Decoded into a spare model sized at construction, then swapped in: no allocation per model.
+  if (!dds::from_msg(state, candidate_)) {
     ++stats_.calibrations_rejected;
     return;
   }
-  if (!model_.friction.delta_rev.empty() && m.friction.delta_rev != model_.friction.delta_rev) {
+  if (!model_.friction.delta_rev.empty() && candidate_.friction.delta_rev != model_.friction.delta_rev) {
     ++stats_.calibrations_rejected;  // thresholds are fixed by the calibrator config
     return;
   }
-  model_ = std::move(m);
+  std::swap(model_, candidate_);
   ++stats_.calibrations_applied;
 }
 
@@ -147,7 +151,7 @@ const msg::MeasurementBlock* CornerNode::simulate_period(std::uint64_t k) {
   block_.period_start_s(sim_.time_s());
   block_.samples().clear();
   faults::WatchdogOutput w;
-  msg::MeasurementSample m;
+  msg::MeasurementSample& m = sample_;  // reused: a message's default constructor re-registers its TypeObject
   for (std::uint64_t i = 0; i < steps_per_period_; ++i) {
     const double t_end = sim_.time_s() + dt;
     // Force mode: the CCU's command through the watchdog (hold, then the default, if it is lost).

@@ -43,10 +43,8 @@ InProcessRun::~InProcessRun() { ccu_.set_observer(nullptr); }
 void InProcessRun::corner_period(CornerEnd& c, std::uint64_t k) {
   if (c.stopped) return;
   // drain_inputs: commands, then calibration states.
-  msg::ClampCommand cmd;
-  while (c.command_in->take(cmd)) c.node->on_command(cmd, 0.0);
-  msg::CalibrationState state;
-  while (c.calibration_in->take(state)) c.node->on_calibration(state);
+  while (c.command_in->take(command_)) c.node->on_command(command_, 0.0);
+  while (c.calibration_in->take(state_)) c.node->on_calibration(state_);
   if (!c.started) {
     if (!c.node->have_command()) return;
     c.node->start();
@@ -66,18 +64,17 @@ void InProcessRun::ccu_intake(double t_end_s) {
   for (std::size_t i = 0; i < corners_.size(); ++i) {
     while (corners_[i].block_in->take(block_, from)) {
       ccu_.on_block(i, block_, from, t_end_s);
-      for (const msg::CalibrationState& s : ccu_.calibration_updates()) calibration_out_->send(s);
+      for (const msg::CalibrationState* s : ccu_.calibration_updates()) calibration_out_->send(*s);
       ccu_.clear_calibration_updates();
     }
-    msg::CornerHealth h;
-    while (corners_[i].health_in->take(h)) ccu_.on_health(i, h);
+    while (corners_[i].health_in->take(health_)) ccu_.on_health(i, health_);
   }
 }
 
 bool InProcessRun::step() {
   const std::uint64_t k = next_;
   if (k >= ccu_.periods()) return false;
-  const double t_end = static_cast<double>(k + 1) * scenario_.ccu_period_s;
+  const double t_end = ccu_.period_end_s(k);
   if (k == 0) ccu_intake(0.0);  // the corners' start-up health
   for (const msg::ClampCommand& c : ccu_.commands(k, false)) command_out_->send(c);
   for (CornerEnd& c : corners_) corner_period(c, k);

@@ -62,6 +62,7 @@ struct CornerChannel {
   std::uint64_t sample_gaps = 0;       // samples missing between consecutive blocks (within one)
   std::uint64_t rejoins = 0;           // new incarnations seen
   std::uint64_t command_seq = 0;
+  double last_friction_kN = 0.0;       // the calibrator's friction estimate at the last sample (sent with commands)
   std::uint64_t calibration_version = 0;
   std::uint64_t published_fits = 0;
   std::uint64_t published_restarts = 0;
@@ -112,9 +113,9 @@ class CcuNode {
   const std::vector<msg::ClampCommand>& commands(std::uint64_t step, bool stop, bool log = true);
   // Each corner's calibration state at version 0 (thresholds and initial curve, before period 0).
   const std::vector<msg::CalibrationState>& initial_states();
-  // Calibration states to publish after the samples processed since the last call (a fit was
-  // accepted, or a calibrator restarted).
-  const std::vector<msg::CalibrationState>& calibration_updates() { return updates_; }
+  // Calibration states to publish after the samples processed since the last clear (a fit was
+  // accepted, or a calibrator restarted): the newest per corner, in memory kept per corner.
+  const std::vector<const msg::CalibrationState*>& calibration_updates() const { return updates_; }
   void clear_calibration_updates() { updates_.clear(); }
 
   // The period's end: refill the flood guard, tick the supervisors, log new detections.
@@ -137,6 +138,10 @@ class CcuNode {
   const CornerChannel* channel_of(std::uint8_t wire_id) const;
   const CcuCore& core() const { return core_; }
   std::uint64_t periods() const { return periods_; }
+  // Simulated start and end of period k, as every adapter must compute them (k T, then + T:
+  // the rounding is part of the lockstep's reproducibility).
+  double period_start_s(std::uint64_t k) const { return static_cast<double>(k) * scenario_.ccu_period_s; }
+  double period_end_s(std::uint64_t k) const { return period_start_s(k) + scenario_.ccu_period_s; }
   std::uint64_t unknown_corner_blocks() const { return unknown_corner_blocks_; }
   const std::vector<DetectionRecord>& detections() const { return detections_; }
 
@@ -150,7 +155,8 @@ class CcuNode {
   LockstepBarrier barrier_;               // before channels_: make_channels adds the participants
   std::vector<CornerChannel> channels_;
   std::vector<msg::ClampCommand> commands_;
-  std::vector<msg::CalibrationState> updates_;
+  std::vector<msg::CalibrationState> states_;            // one per channel, reused (no allocation per fit)
+  std::vector<const msg::CalibrationState*> updates_;
   std::vector<msg::CalibrationState> initial_;
   std::vector<DetectionRecord> detections_;
   std::uint64_t unknown_corner_blocks_ = 0;

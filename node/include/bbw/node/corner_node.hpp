@@ -141,10 +141,12 @@ class CornerNode {
   faults::WatchdogMode last_mode_ = faults::WatchdogMode::Normal;
 
   msg::MeasurementBlock block_;
+  msg::MeasurementSample sample_;
   msg::ClampCommand latest_command_;
   bool have_command_ = false;
   std::optional<std::uint64_t> last_command_seq_;
   dds::CalibrationModel model_;
+  dds::CalibrationModel candidate_;
   calibration::FrictionTracker friction_;  // element and play states of the CCU's friction model
   CornerStats stats_;
   CornerObserver* observer_ = nullptr;

@@ -70,7 +70,11 @@ class InProcessRun {
   std::unique_ptr<transport::Outlet<msg::ClampCommand>> command_out_;
   std::unique_ptr<transport::Outlet<msg::CalibrationState>> calibration_out_;
   std::vector<CornerEnd> corners_;
+  // Scratch messages, reused: a message's default constructor re-registers its TypeObject.
   msg::MeasurementBlock block_;
+  msg::ClampCommand command_;
+  msg::CalibrationState state_;
+  msg::CornerHealth health_;
   std::uint64_t next_ = 0;
   transport::EndpointId next_endpoint_ = 1;
 };
