@@ -44,12 +44,11 @@ CcuCore::CcuCore(const scenario::Scenario& scenario, const calibration::Calibrat
     // near 35 C). On the paper's rig (corners follow their own position profile at 30-60 C and
     // up to 12 rev/s) they raise false load-cell findings (3 of 4 corners in
     // tests/system/data/short_rig.yaml), and the CCU has no command there to react with: rig
-    // corners keep the guard and the link, stuck, noise, dropout and actuator rules only.
+    // corners keep the guard and the link, stuck, noise, dropout and actuator rules only, unless
+    // config/faults/monitor.yaml says residual.on_profile_corners: true.
     faults::MonitorParams corner_mp = mp;
-    if (scenario.corners[i].drive.mode != scenario::DriveMode::Demand) {
-      corner_mp.residual_threshold_kN = corner_mp.uncalibrated_residual_threshold_kN =
-          corner_mp.residual_change_threshold_kN = 1e9;
-    }
+    corner_mp.residual_findings =
+        scenario.corners[i].drive.mode == scenario::DriveMode::Demand || mp.residual_on_profile_corners;
     supervisors_[*slot] = std::make_unique<faults::CornerSupervisor>(
         calibrator, corner_mp, static_cast<faults::Target>(*slot));
     scenario_index_[*slot] = i;

@@ -1,11 +1,15 @@
-// Per-corner fault detection and isolation in the CCU (docs/faults.md, "Detection"). Pure: no
-// DDS, clock, file or thread; time comes with the samples and with tick(now_s). Memory is sized
-// at construction; update() and tick() do not allocate.
+// Per-corner fault detection and isolation in the CCU (docs/faults.md, "Detection"): one
+// detector per fault family (bbw/faults/detectors/: dropout, stuck channels, resolver jump,
+// residual with noise, actuator torque balance, tracking, link) and an arbiter that latches each
+// part's Diagnosis. Every threshold is a MonitorParams field, loaded from
+// config/faults/monitor.yaml (bbw/faults/monitor_yaml.hpp). Pure: no DDS, clock, file or thread;
+// time comes with the samples and with tick(now_s). Memory is sized at construction; update()
+// and tick() do not allocate.
 //
 // Fed, per sample, the guard's verdict, the reading and (when the calibrator was fed it) the
 // calibrator's estimate; fed link events from outside (DDS deadline / liveliness, or the
-// in-memory harness). Each part's first confirmed fault is latched as a Diagnosis; link and
-// process losses clear when samples arrive again.
+// in-memory runner). Each part's first confirmed fault is latched; link and process losses
+// clear when samples arrive again.
 #pragma once
 
 #include <array>
@@ -17,6 +21,16 @@
 #include "bbw/faults/reading.hpp"
 #include "bbw/faults/sample_guard.hpp"
 #include "bbw/faults/schedule.hpp"
+#include "bbw/faults/arbiter.hpp"
+#include "bbw/faults/detectors/dropout_detector.hpp"
+#include "bbw/faults/detectors/jump_detector.hpp"
+#include "bbw/faults/detectors/link_detector.hpp"
+#include "bbw/faults/detectors/noise_detector.hpp"
+#include "bbw/faults/detectors/residual_detector.hpp"
+#include "bbw/faults/detectors/stuck_detector.hpp"
+#include "bbw/faults/detectors/torque_detector.hpp"
+#include "bbw/faults/detectors/tracking_detector.hpp"
+#include "bbw/faults/finding.hpp"
 
 namespace bbw::faults {
 
@@ -37,6 +51,11 @@ struct MonitorParams {
   // x_max_rev of the calibrator config here). Outside it the cubic is an extrapolation.
   double curve_min_rev = 1.0;
   double curve_max_rev = 6.0;
+  // Whether residual disagreements become findings on corners that follow their own position
+  // profile (the paper's rig: 30-60 C, up to 12 rev/s, no command to react with). The residual
+  // is still computed (and feeds the noise detector) when this is false. CcuCore applies it.
+  bool residual_on_profile_corners = false;
+  bool residual_findings = true;  // set per corner by CcuCore from the rule above
 
   // Resolver consistency: a position step the measured speed does not explain.
   double jump_threshold_rev = 0.01;
@@ -89,39 +108,6 @@ struct MonitorParams {
 
   void validate() const;  // throws std::invalid_argument naming the field, value and rule
 };
-inline constexpr int kMaxNoiseWindow = 256;
-
-enum class Finding : std::uint8_t {
-  None,
-  LoadCellOffset,    // residual, no resolver signature (bias, drift)
-  LoadCellStuck,
-  LoadCellNoisy,
-  LoadCellMissing,   // dropout
-  ResolverOffset,
-  ResolverStuck,
-  ActuatorTorqueLoss,  // part of the torque is missing; the loop still reaches the command
-  ActuatorLost,        // (almost) no torque for the current drawn
-  ActuatorTracking,    // cannot follow a reachable command
-  ActuatorNotReleasing,  // holds a force well above the command (jammed, seized): over-application
-  LinkLost,          // deadline missed / no samples
-  ProcessLost,       // liveliness lost, or a new process of the corner joined
-};
-const char* to_string(Finding f);
-Part part_of(Finding f);  // Finding::None -> Part::LoadCell (unused)
-
-struct Diagnosis {
-  bool present = false;    // confirmed at least once
-  bool active = false;     // still in force (sensor/actuator findings latch; link/process clear)
-  Finding finding = Finding::None;
-  double onset_s = 0.0;    // when the condition started (best estimate)
-  double detected_s = 0.0; // when it was confirmed
-  double finding_s = 0.0;  // when the current finding was confirmed (later after an upgrade)
-};
-
-// Restarted: a new process of the corner (a higher incarnation) has sent its first samples, so
-// the one before it is gone: an outage still open is the process's death, not the link's.
-enum class LinkEvent : std::uint8_t { DeadlineMissed, LivelinessLost, LivelinessRecovered, Restarted };
-
 class FaultMonitor {
  public:
   FaultMonitor(const MonitorParams& params, Target corner);  // throws std::invalid_argument
@@ -131,99 +117,46 @@ class FaultMonitor {
   // the CCU currently believes (NaN when it has none); arrival_s is when the CCU got it.
   void update(const CornerReading& r, const SampleCheck& check, const calibration::Estimate* estimate,
               double force_estimate_kN, double arrival_s);
-  void on_link_event(LinkEvent e, double time_s);
+  void on_link_event(LinkEvent e, double time_s) { link_.on_link_event(e, time_s, arbiter_); }
   // Deadline check at the CCU's time now_s.
-  void tick(double now_s);
+  void tick(double now_s) { link_.tick(now_s, p_, arbiter_); }
 
-  const Diagnosis& diagnosis(Part p) const { return diag_[static_cast<std::size_t>(p)]; }
-  bool ok(Part p) const { return !diag_[static_cast<std::size_t>(p)].active; }
+  const Diagnosis& diagnosis(Part p) const { return arbiter_.diagnosis(p); }
+  bool ok(Part p) const { return arbiter_.ok(p); }
   // Samples arrived again after a link or process loss; cleared by take_rejoin().
-  bool rejoined() const { return rejoined_; }
-  bool take_rejoin();
+  bool rejoined() const { return link_.rejoined(); }
+  bool take_rejoin() { return link_.take_rejoin(); }
   // Whether the last loss was the process (liveliness), so its sequence starts again.
-  bool process_was_lost() const { return process_lost_since_rejoin_; }
+  bool process_was_lost() const { return link_.process_was_lost(); }
   // Delivered / expected torque, from the last torque check (1 until one ran).
-  double torque_fraction() const { return torque_fraction_; }
+  double torque_fraction() const { return torque_.fraction(); }
   // Narrows the residual check to where the calibrator's fits had data.
   void set_curve_range(double min_rev, double max_rev);
   // The last residual inside the curve's range (NaN outside it or before the first).
-  double last_residual_kN() const { return residual_kN_; }
+  double last_residual_kN() const { return residual_.residual_kN(); }
   // The last residual minus its reference level (NaN where the residual is).
-  double last_residual_change_kN() const { return residual_change_kN_; }
+  double last_residual_change_kN() const { return residual_.change_kN(); }
   // Share of large residual steps in the noise window.
-  double last_noise_fraction() const { return noise_kN_; }
+  double last_noise_fraction() const { return noise_.fraction(); }
   Target corner() const { return corner_; }
   const MonitorParams& params() const { return p_; }
 
  private:
-  void confirm(Finding f, double onset_s, double now_s);
-  void clear(Part p);
-  void check_residual(const CornerReading& r, const calibration::Estimate& e);
-  void check_noise(double residual_kN, double t);
-  void check_actuator(const CornerReading& r, const SampleCheck& c, double force_estimate_kN, double dt_s);
-
   MonitorParams p_;
   Target corner_;
-  std::array<Diagnosis, 5> diag_{};
-
-  // previous usable sample
+  DiagnosisArbiter arbiter_;
+  DropoutDetector dropout_;
+  JumpDetector jump_;
+  StuckDetector stuck_;
+  NoiseDetector noise_;
+  ResidualDetector residual_;
+  TorqueDetector torque_;
+  TrackingDetector tracking_;
+  LinkDetector link_;
+  // The previous usable sample (continuity for the detectors; broken by a rejoin).
   bool have_prev_ = false;
   CornerReading prev_{};
   bool prev_lc_present_ = false;
-  // residual
-  bool residual_suspect_ = false;
-  double residual_onset_s_ = 0.0;
-  double residual_kN_ = std::numeric_limits<double>::quiet_NaN();
-  double residual_change_kN_ = std::numeric_limits<double>::quiet_NaN();
-  bool have_reference_ = false;
-  bool reference_calibrated_ = false;  // the calibrator's state when the reference was set
-  double reference_kN_ = 0.0;
-  double reference_time_s_ = 0.0;
-  bool have_prev_residual_ = false;
-  double prev_residual_kN_ = 0.0;
-  // resolver jumps
-  double last_jump_s_ = -1e300;
-  double pending_jump_rev_ = 0.0;
-  double pending_jump_s_ = 0.0;
-  bool jump_pending_ = false;
-  // stuck runs
-  int lc_repeat_ = 0;
-  double lc_run_onset_s_ = 0.0;
-  double run_pos_min_ = 0.0, run_pos_max_ = 0.0;
-  int pos_repeat_ = 0;
-  double pos_run_onset_s_ = 0.0;
-  double run_lc_min_ = 0.0, run_lc_max_ = 0.0;
-  // noise window of squared residual differences
-  std::array<std::uint8_t, kMaxNoiseWindow> noise_big_{};
-  int noise_count_ = 0;
-  int noise_head_ = 0;
-  int noise_big_count_ = 0;
-  double noise_kN_ = 0.0;   // share of big steps in the window
-  // dropout
-  int missing_run_ = 0;
-  double missing_onset_s_ = 0.0;
-  // actuator
-  bool torque_suspect_ = false;
-  double torque_onset_s_ = 0.0;
-  bool lost_suspect_ = false;
-  double lost_onset_s_ = 0.0;
-  bool torque_init_ = false;
-  double need_Nm_ = 0.0;
-  double make_Nm_ = 0.0;
-  double curve_min_rev_ = 0.0;
-  double curve_max_rev_ = 0.0;
-  double torque_fraction_ = 1.0;
-  bool tracking_suspect_ = false;
-  double tracking_onset_s_ = 0.0;
-  bool excess_suspect_ = false;
-  double excess_onset_s_ = 0.0;
-  bool model_init_ = false;
-  double model_kN_ = 0.0;
-  // link
-  bool any_arrival_ = false;
-  double last_arrival_s_ = 0.0;
-  bool rejoined_ = false;
-  bool process_lost_since_rejoin_ = false;
 };
 
 }  // namespace bbw::faults

@@ -1,0 +1,26 @@
+// Stuck channels: a load cell repeating its value exactly while the position travels
+// (LoadCellStuck), a resolver repeating its position while the load cell changes
+// (ResolverStuck). The run lengths also tell the residual detector which channel is frozen.
+#pragma once
+
+#include "bbw/faults/detectors/detector.hpp"
+
+namespace bbw::faults {
+
+class StuckDetector {
+ public:
+  void update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a);
+  void on_rejoin() { lc_repeat_ = pos_repeat_ = 0; }
+  int load_cell_repeats() const { return lc_repeat_; }
+  int position_repeats() const { return pos_repeat_; }
+
+ private:
+  int lc_repeat_ = 0;
+  double lc_run_onset_s_ = 0.0;
+  double run_pos_min_ = 0.0, run_pos_max_ = 0.0;
+  int pos_repeat_ = 0;
+  double pos_run_onset_s_ = 0.0;
+  double run_lc_min_ = 0.0, run_lc_max_ = 0.0;
+};
+
+}  // namespace bbw::faults

@@ -1,0 +1,30 @@
+// Actuator torque balance: the torque the axial load and the acceleration need,
+// load * Nm_per_kN + J 2 pi a, against the torque the measured current should make,
+// i * torque_per_A; both low-pass filtered, their ratio is the delivered torque fraction. Below
+// torque_lost_threshold at any speed: ActuatorLost; below torque_fraction_threshold at
+// standstill: ActuatorTorqueLoss. Not checked while the resolver is faulty.
+#pragma once
+
+#include "bbw/faults/detectors/detector.hpp"
+
+namespace bbw::faults {
+
+class TorqueDetector {
+ public:
+  // `load_kN`: the load cell while it is trusted, else the CCU's force estimate.
+  void update(const SampleContext& c, double load_kN, const MonitorParams& p, DiagnosisArbiter& a);
+  void on_rejoin() { torque_init_ = torque_suspect_ = lost_suspect_ = false; }
+  double fraction() const { return fraction_; }
+
+ private:
+  bool torque_suspect_ = false;
+  double torque_onset_s_ = 0.0;
+  bool lost_suspect_ = false;
+  double lost_onset_s_ = 0.0;
+  bool torque_init_ = false;
+  double need_Nm_ = 0.0;
+  double make_Nm_ = 0.0;
+  double fraction_ = 1.0;
+};
+
+}  // namespace bbw::faults

@@ -1,0 +1,17 @@
+#include "bbw/faults/detectors/dropout_detector.hpp"
+
+#include "bbw/faults/fault_monitor.hpp"
+
+namespace bbw::faults {
+
+void DropoutDetector::update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a) {
+  const double t = c.r.time_s;
+  if (!c.check.load_cell_present) {
+    if (missing_run_ == 0) missing_onset_s_ = t;
+    if (++missing_run_ >= p.dropout_samples) a.confirm(Finding::LoadCellMissing, missing_onset_s_, t);
+  } else {
+    missing_run_ = 0;
+  }
+}
+
+}  // namespace bbw::faults

@@ -1,0 +1,53 @@
+#include "bbw/faults/detectors/link_detector.hpp"
+
+#include "bbw/faults/fault_monitor.hpp"
+
+namespace bbw::faults {
+
+bool LinkDetector::on_arrival(double arrival_s, DiagnosisArbiter& a) {
+  bool rejoin = false;
+  if (!a.ok(Part::Network) || !a.ok(Part::Process)) {
+    a.clear(Part::Network);
+    a.clear(Part::Process);
+    rejoined_ = true;
+    rejoin = true;
+  }
+  any_arrival_ = true;
+  last_arrival_s_ = arrival_s;
+  return rejoin;
+}
+
+bool LinkDetector::take_rejoin() {
+  const bool r = rejoined_;
+  rejoined_ = false;
+  process_lost_since_rejoin_ = false;
+  return r;
+}
+
+void LinkDetector::on_link_event(LinkEvent e, double time_s, DiagnosisArbiter& a) {
+  switch (e) {
+    case LinkEvent::DeadlineMissed:
+      if (a.ok(Part::Process)) a.confirm(Finding::LinkLost, any_arrival_ ? last_arrival_s_ : time_s, time_s);
+      break;
+    case LinkEvent::LivelinessLost:
+      a.confirm(Finding::ProcessLost, any_arrival_ ? last_arrival_s_ : time_s, time_s);
+      process_lost_since_rejoin_ = true;
+      break;
+    case LinkEvent::LivelinessRecovered: break;  // samples arriving decide the rejoin
+    case LinkEvent::Restarted:
+      // Faster than the participant lease (2 s) when the launcher restarts the process within it.
+      if (a.ok(Part::Process)) {
+        a.confirm(Finding::ProcessLost, any_arrival_ ? last_arrival_s_ : time_s, time_s);
+        process_lost_since_rejoin_ = true;
+      }
+      break;
+  }
+}
+
+void LinkDetector::tick(double now_s, const MonitorParams& p, DiagnosisArbiter& a) {
+  if (any_arrival_ && now_s - last_arrival_s_ > p.deadline_s && a.ok(Part::Network) && a.ok(Part::Process)) {
+    a.confirm(Finding::LinkLost, last_arrival_s_, now_s);
+  }
+}
+
+}  // namespace bbw::faults

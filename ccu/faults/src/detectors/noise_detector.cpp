@@ -1,0 +1,28 @@
+#include "bbw/faults/detectors/noise_detector.hpp"
+
+#include <cmath>
+
+#include "bbw/faults/fault_monitor.hpp"
+
+namespace bbw::faults {
+
+void NoiseDetector::update(double residual_kN, double t, const MonitorParams& p, DiagnosisArbiter& a) {
+  if (!have_prev_residual_) {
+    have_prev_residual_ = true;
+    prev_residual_kN_ = residual_kN;
+    return;
+  }
+  const double d = residual_kN - prev_residual_kN_;
+  prev_residual_kN_ = residual_kN;
+  const int w = p.noise_window_samples;
+  const auto h = static_cast<std::size_t>(head_);
+  if (count_ == w) big_count_ -= big_[h];
+  big_[h] = std::abs(d) > p.noise_step_kN ? 1 : 0;
+  big_count_ += big_[h];
+  head_ = (head_ + 1) % w;
+  if (count_ < w) ++count_;
+  fraction_ = static_cast<double>(big_count_) / w;
+  if (fraction_ >= p.noise_min_fraction) a.confirm(Finding::LoadCellNoisy, t, t);
+}
+
+}  // namespace bbw::faults

@@ -1,0 +1,46 @@
+#include "bbw/faults/detectors/stuck_detector.hpp"
+
+#include <algorithm>
+
+#include "bbw/faults/fault_monitor.hpp"
+
+namespace bbw::faults {
+
+void StuckDetector::update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a) {
+  if (!c.have_prev) return;
+  const CornerReading& r = c.r;
+  const CornerReading& prev = c.prev;
+  const double t = r.time_s;
+  // Stuck load cell: the same value again while the position travels.
+  if (c.check.load_cell_present && c.prev_load_cell_present && r.load_cell_kN == prev.load_cell_kN) {
+    if (lc_repeat_ == 0) {
+      lc_run_onset_s_ = prev.time_s;
+      run_pos_min_ = run_pos_max_ = prev.position_rev;
+    }
+    ++lc_repeat_;
+    run_pos_min_ = std::min(run_pos_min_, r.position_rev);
+    run_pos_max_ = std::max(run_pos_max_, r.position_rev);
+    if (lc_repeat_ >= p.stuck_samples && run_pos_max_ - run_pos_min_ >= p.stuck_min_travel_rev) {
+      a.confirm(Finding::LoadCellStuck, lc_run_onset_s_, t);
+    }
+  } else {
+    lc_repeat_ = 0;
+  }
+  // Stuck resolver: the same position again while the load cell changes.
+  if (r.position_rev == prev.position_rev && c.check.load_cell_present) {
+    if (pos_repeat_ == 0) {
+      pos_run_onset_s_ = prev.time_s;
+      run_lc_min_ = run_lc_max_ = r.load_cell_kN;
+    }
+    ++pos_repeat_;
+    run_lc_min_ = std::min(run_lc_min_, r.load_cell_kN);
+    run_lc_max_ = std::max(run_lc_max_, r.load_cell_kN);
+    if (pos_repeat_ >= p.stuck_samples && run_lc_max_ - run_lc_min_ >= p.stuck_min_force_change_kN) {
+      a.confirm(Finding::ResolverStuck, pos_run_onset_s_, t);
+    }
+  } else if (r.position_rev != prev.position_rev) {
+    pos_repeat_ = 0;
+  }
+}
+
+}  // namespace bbw::faults

@@ -1,0 +1,53 @@
+#include "bbw/faults/detectors/tracking_detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "bbw/faults/fault_monitor.hpp"
+
+namespace bbw::faults {
+
+void TrackingDetector::update(const SampleContext& c, double force_estimate_kN, const MonitorParams& p,
+                              DiagnosisArbiter& a) {
+  const CornerReading& r = c.r;
+  const double t = r.time_s;
+  const double cmd = r.force_command_kN;
+  if (!std::isfinite(cmd) || !std::isfinite(force_estimate_kN)) {
+    model_init_ = false;
+    tracking_suspect_ = excess_suspect_ = false;
+    return;
+  }
+  if (!model_init_ || c.dt_s <= 0.0) {
+    model_init_ = true;
+    model_kN_ = force_estimate_kN;
+  } else {
+    model_kN_ += (cmd - model_kN_) * -std::expm1(-c.dt_s / p.tracking_time_constant_s);
+  }
+  // A shortfall counts below both the command and the model, an excess above both (a release
+  // faster than the model, or an apply faster than it, is not a fault).
+  const double limit = std::max(p.tracking_threshold_kN, p.tracking_relative * std::abs(cmd));
+  const bool reachable = cmd <= p.force_limit_kN;
+  if (reachable && std::min(cmd, model_kN_) - force_estimate_kN > limit) {
+    if (!tracking_suspect_) {
+      tracking_suspect_ = true;
+      tracking_onset_s_ = t;
+    }
+    if (t - tracking_onset_s_ >= p.tracking_persist_s) a.confirm(Finding::ActuatorTracking, tracking_onset_s_, t);
+  } else {
+    tracking_suspect_ = false;
+  }
+  // Over-application: the brake holds a force well above what it is told and was told. Any
+  // command counts (a brake told to release must release, whatever the force limit).
+  const bool moving_back = r.speed_rev_per_s < -p.release_min_speed_rev_per_s;
+  if (!moving_back && force_estimate_kN - std::max(cmd, model_kN_) > limit) {
+    if (!excess_suspect_) {
+      excess_suspect_ = true;
+      excess_onset_s_ = t;
+    }
+    if (t - excess_onset_s_ >= p.tracking_persist_s) a.confirm(Finding::ActuatorNotReleasing, excess_onset_s_, t);
+  } else {
+    excess_suspect_ = false;
+  }
+}
+
+}  // namespace bbw::faults

@@ -1,0 +1,95 @@
+#include "bbw/faults/monitor_yaml.hpp"
+
+#include <stdexcept>
+
+namespace bbw::faults {
+
+using bbw::config::Range;
+using bbw::config::Reader;
+
+MonitorParams read_monitor_params(Reader& r) {
+  MonitorParams p;
+  const Range pos = Range::positive();
+  auto g = r.map("guard");
+  p.guard.position_min_rev = g.number("position_min_rev");
+  p.guard.position_max_rev = g.number("position_max_rev");
+  p.guard.speed_abs_max_rev_per_s = g.number("speed_abs_max_rev_per_s", pos);
+  p.guard.load_cell_min_kN = g.number("load_cell_min_kN");
+  p.guard.load_cell_max_kN = g.number("load_cell_max_kN");
+  p.guard.current_abs_max_A = g.number("current_abs_max_A", pos);
+  p.guard.max_sequence_jump = g.number("max_sequence_jump", Range::at_least(1.0));
+  p.guard.max_time_jump_s = g.number("max_time_jump_s", pos);
+  g.finish();
+
+  auto res = r.map("residual");
+  p.residual_threshold_kN = res.number("threshold_kN", pos);
+  p.uncalibrated_residual_threshold_kN = res.number("uncalibrated_threshold_kN", pos);
+  p.residual_persist_s = res.number("persist_s", pos);
+  p.residual_reference_s = res.number("reference_s", pos);
+  p.residual_change_threshold_kN = res.number("change_threshold_kN", pos);
+  p.curve_min_rev = res.number("curve_min_rev");
+  p.curve_max_rev = res.number("curve_max_rev");
+  p.residual_on_profile_corners = res.boolean("on_profile_corners");
+  res.finish();
+
+  auto j = r.map("resolver_jump");
+  p.jump_threshold_rev = j.number("threshold_rev", pos);
+  p.jump_confirm_s = j.number("confirm_s", pos);
+  p.jump_window_s = j.number("window_s", pos);
+  j.finish();
+
+  auto s = r.map("stuck");
+  p.stuck_samples = static_cast<int>(s.integer("samples", 2, 100000));
+  p.stuck_min_travel_rev = s.number("min_travel_rev", pos);
+  p.stuck_min_force_change_kN = s.number("min_force_change_kN", pos);
+  p.frozen_attribution_samples = static_cast<int>(s.integer("frozen_attribution_samples", 2, 100000));
+  s.finish();
+
+  auto n = r.map("noise");
+  p.noise_window_samples = static_cast<int>(n.integer("window_samples", 4, kMaxNoiseWindow));
+  p.noise_step_kN = n.number("step_kN", pos);
+  p.noise_min_fraction = n.number("min_fraction", Range{0.0, 1.0, true, false});
+  n.finish();
+
+  auto d = r.map("dropout");
+  p.dropout_samples = static_cast<int>(d.integer("samples", 1, 100000));
+  d.finish();
+
+  auto t = r.map("torque");
+  p.torque_filter_s = t.number("filter_s", pos);
+  p.torque_check_min_load_kN = t.number("check_min_load_kN", pos);
+  p.torque_check_min_torque_Nm = t.number("check_min_torque_Nm", pos);
+  p.torque_fraction_threshold = t.number("fraction_threshold", Range{0.0, 1.0, true, true});
+  p.torque_check_max_speed_rev_per_s = t.number("check_max_speed_rev_per_s", pos);
+  p.torque_persist_s = t.number("persist_s", pos);
+  p.torque_lost_threshold = t.number("lost_threshold", Range{0.0, 1.0, true, true});
+  p.torque_lost_persist_s = t.number("lost_persist_s", pos);
+  t.finish();
+
+  auto k = r.map("tracking");
+  p.tracking_time_constant_s = k.number("time_constant_s", pos);
+  p.tracking_threshold_kN = k.number("threshold_kN", pos);
+  p.tracking_relative = k.number("relative", Range{0.0, 1.0, false, true});
+  p.tracking_persist_s = k.number("persist_s", pos);
+  p.force_limit_kN = k.number("force_limit_kN", pos);
+  p.release_min_speed_rev_per_s = k.number("release_min_speed_rev_per_s", pos);
+  k.finish();
+
+  auto l = r.map("link");
+  p.deadline_s = l.number("deadline_s", pos);
+  l.finish();
+  r.finish();
+  try {
+    p.validate();
+  } catch (const std::invalid_argument& e) {
+    r.fail("", e.what());
+  }
+  return p;
+}
+
+MonitorParams load_monitor_params(const std::string& file) {
+  Reader r = Reader::from_file(file);
+  return read_monitor_params(r);
+}
+
+}  // namespace bbw::faults
