@@ -166,6 +166,9 @@ TEST(ClosedLoop, LoadCellBiasOfOneKilonewtonIsIsolatedWithin100msAndTheCurveEsti
 
 TEST(ClosedLoop, OneCornerLostDuringAStopTotalBackAbove90PercentWithin100ms) {
   // Remaining limits: 3 x 40 kN = 120 kN, more than the 66.7 kN demanded at 0.5.
+  // A killed corner's plant dies with its process (as over DDS: it lived in the corner process),
+  // so it brakes 0 from the kill on: the worst case (an unpowered ball screw would be back-driven
+  // over ~0.3 s). The others must make up its whole share within 100 ms.
   std::printf("%-6s %-11s %10s %14s %18s\n", "corner", "loss", "detected", "recovered", "lowest share");
   for (Target c : kAll) {
     for (FaultType t : {FaultType::TotalLoss, FaultType::Kill}) {

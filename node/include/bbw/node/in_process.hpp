@@ -73,8 +73,8 @@ class InProcessRun {
   void set_corner_observer(std::size_t i, CornerObserver* observer);
   void set_block_tap(BlockTap tap) { tap_ = std::move(tap); }
 
-  // Process state (process faults): the CCU is up; corner i's process is up (false between a
-  // kill and the restart; a restarted corner is up before it starts, at its resume period).
+  // Process state (process faults): the CCU is up; corner i's process is up (false after a kill
+  // with no restart; a restart's new process is up at once and starts at its resume period).
   bool ccu_alive() const { return ccu_alive_; }
   bool corner_alive(std::size_t i) const { return !corners_[i].dead; }
   std::uint32_t incarnation(std::size_t i) const { return corners_[i].node->incarnation(); }
