@@ -28,8 +28,8 @@ faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, fau
 }
 
 CcuCore::CcuCore(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator,
-                 const faults::MonitorParams& monitor)
-    : scenario_(scenario), planner_(scenario) {
+                 const faults::MonitorParams& monitor, ReactionPolicy policy)
+    : scenario_(scenario), policy_(policy), planner_(scenario) {
   const faults::MonitorParams mp = monitor_params_for(scenario, monitor);
   for (std::size_t i = 0; i < scenario.corners.size(); ++i) {
     const auto slot = slot_of(scenario.corners[i].name);
@@ -116,10 +116,10 @@ const std::array<CornerPlan, kSlots>& CcuCore::plan(double time_s) {
     p.available = v.available;
     p.feedback = v.feedback;
     p.curve = v.curve;
-    cap[s] = {v.available, v.force_limit_kN, v.held_kN};
+    cap[s] = {v.available, v.force_limit_kN, policy_.count_held_force ? v.held_kN : 0.0};
     all_available = all_available && v.available;
   }
-  if (!all_available && redistributor_) {
+  if (!all_available && redistributor_ && policy_.redistribute) {
     const faults::Allocation a = redistributor_->allocate(demand_total_kN(time_s), cap);
     for (std::size_t s = 0; s < kSlots; ++s) {
       if (supervisors_[s] && plans_[s].mode == CommandMode::Force) plans_[s].clamp_force_kN = a.force_kN[s];

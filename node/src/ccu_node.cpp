@@ -26,6 +26,8 @@ std::vector<CornerChannel> make_channels(const scenario::Scenario& s, LockstepBa
   return out;
 }
 
+}  // namespace
+
 faults::CornerReading reading_from(const msg::MeasurementSample& s) {
   faults::CornerReading r;
   r.seq = s.seq();
@@ -39,6 +41,8 @@ faults::CornerReading reading_from(const msg::MeasurementSample& s) {
   return r;
 }
 
+namespace {
+
 std::uint8_t feedback_code(const std::optional<corner_unit::ForceFeedback>& f) {
   if (!f) return msg::FEEDBACK_OWN;
   return *f == corner_unit::ForceFeedback::Curve ? msg::FEEDBACK_CURVE : msg::FEEDBACK_LOAD_CELL;
@@ -47,9 +51,9 @@ std::uint8_t feedback_code(const std::optional<corner_unit::ForceFeedback>& f) {
 }  // namespace
 
 CcuNode::CcuNode(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator,
-                 bool friction_feedback)
+                 bool friction_feedback, const faults::MonitorParams& monitor, ccu::ReactionPolicy policy)
     : scenario_(scenario),
-      core_(scenario, calibrator),
+      core_(scenario, calibrator, monitor, policy),
       friction_feedback_(friction_feedback),
       periods_(periods_of(scenario)),
       channels_(make_channels(scenario, barrier_)) {

@@ -1,17 +1,20 @@
-// In-memory closed loop for fault tests (no DDS): four CornerSims with their fault injectors
-// and CCU watchdogs, and a CCU made of one CornerSupervisor per corner and the Redistributor,
-// on one time base. Samples travel in blocks of one CCU period, as over DDS in lockstep; the
-// schedule's network faults drop or delay them, a killed corner sends nothing and its motor is
-// unpowered, a killed CCU sends no commands.
+// The closed loop for fault tests: the node cores the processes run (node::InProcessRun: the
+// CcuNode with CcuCore, its CornerSupervisors, calibrators and Redistributor; one CornerNode per
+// corner with its watchdog, friction tracker, fault injector and link faults) over the in-memory
+// transport, in lockstep, with the schedule's process faults carried out as over DDS. This file
+// only records what the nodes did, period by period, and sums it up; it decides nothing.
 #pragma once
+
+#include <bbw/idl/bbw_msgs.h>
 
 #include <array>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "bbw/calibration/config.hpp"
 #include "bbw/faults/ccu_watchdog.hpp"
-#include "bbw/faults/corner_supervisor.hpp"
+#include "bbw/faults/fault_monitor.hpp"
 #include "bbw/faults/outcome.hpp"
 #include "bbw/faults/reading.hpp"
 #include "bbw/faults/redistributor.hpp"
@@ -22,32 +25,33 @@ namespace bbw::faults::test {
 
 std::string source_path(const std::string& rel);
 
-// What a corner's sample tells the CCU (the force command only when it is a force command);
-// seq_offset renumbers a restarted corner's samples.
-CornerReading reading_from(const scenario::CornerSample& s, std::uint64_t seq_offset = 0);
+// What the CCU reads from a simulated corner's sample: the corner's wire conversion
+// (dds::to_msg, into `wire`) followed by the CCU's (node::reading_from), the path every sample
+// takes. `wire` is the caller's, made once (a message's constructor allocates).
+CornerReading reading_from(const scenario::CornerSample& s, msg::MeasurementSample& wire);
 
 struct LoopOptions {
   calibration::CalibratorConfig calibrator;
   MonitorParams monitor;          // actuator model fields are taken from the scenario's plant
   CcuWatchdogParams watchdog;
-  double liveliness_lease_s = 0.02;
   bool redistribute = true;          // false: the CCU keeps the nominal split (for comparison)
   bool count_held_force = true;      // false: a corner that does not release counts as braking 0
-  // Called for every reading a corner sends; fills `out` with what reaches the CCU (default:
-  // the reading itself). Tests add corrupt samples here.
-  std::function<void(std::size_t corner, const CornerReading& r, std::vector<CornerReading>& out)> deliver;
+  // A hostile link: called for every sample a corner sends (corner = slot, 0 FL .. 3 RR); fills
+  // `out` with what reaches the CCU in its place (default: the sample itself).
+  std::function<void(std::size_t corner, const msg::MeasurementSample& s, std::vector<msg::MeasurementSample>& out)>
+      deliver;
 };
 
 LoopOptions default_options();
 
 struct PeriodRecord {
   double time_s = 0.0;                    // end of the period
-  double demand_total_kN = 0.0;           // demanded total clamp force
-  double delivered_total_kN = 0.0;        // sum of true clamp forces
-  std::array<double, kCorners> true_kN{};
-  std::array<double, kCorners> estimate_kN{};
+  double demand_total_kN = 0.0;           // demanded total clamp force (the CCU's demand at the period's start)
+  double delivered_total_kN = 0.0;        // sum of the true clamp forces of the corners that ran the period
+  std::array<double, kCorners> true_kN{};      // NaN: the corner did not run this period (dead process)
+  std::array<double, kCorners> estimate_kN{};  // NaN when the CCU is down
   std::array<double, kCorners> command_kN{};  // what the CCU asked for (NaN when the CCU is down)
-  std::array<double, kCorners> applied_kN{};  // what the corner followed (watchdog output)
+  std::array<double, kCorners> applied_kN{};  // what the corner followed (watchdog output; NaN: none)
   std::array<bool, kCorners> available{};
   std::array<double, kCorners> residual_kN{};  // the monitor's last analytic-redundancy residual
   std::array<double, kCorners> noise_kN{};

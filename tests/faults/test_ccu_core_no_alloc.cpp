@@ -26,6 +26,7 @@ TEST(CcuCoreAllocation, NoHeapAllocationPerSampleOrPeriod) {
     injectors[i] = std::make_unique<faults::FaultInjector>(fs.faults, static_cast<faults::Target>(i), 7);
   }
   const double dt = fs.scenario.plant_dt_s;
+  bbw::msg::MeasurementSample wire;  // the wire sample, reused
   const long before = test::allocation_count();
   double fused_sum = 0.0, command_sum = 0.0;
   for (int k = 0; k < 2800; ++k) {  // 14 s of 5 ms periods
@@ -40,7 +41,7 @@ TEST(CcuCoreAllocation, NoHeapAllocationPerSampleOrPeriod) {
       for (int s = 0; s < 5; ++s) {
         injectors[i]->prepare(ext, sims[i]->time_s() + dt);
         const auto& smp = sims[i]->step(dt, ext);
-        const faults::CornerReading r = faults::test::reading_from(smp);
+        const faults::CornerReading r = faults::test::reading_from(smp, wire);
         const ccu::SampleOutcome& o = core.on_sample(i, r, t0 + fs.scenario.ccu_period_s);
         if (o.valid) fused_sum += o.fused_kN;
       }

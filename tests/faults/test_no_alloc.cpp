@@ -27,6 +27,7 @@ TEST(FaultAllocation, NoHeapAllocationPerSample) {
   CornerSupervisor sup(options.calibrator, options.monitor, Target::FL);
   const Redistributor redistributor(0.6);
   std::array<CornerCapacity, kCorners> cap{};
+  bbw::msg::MeasurementSample wire;  // the wire sample, reused
   const long before = bbw::test::allocation_count();
   double sum = 0.0;
   for (int k = 0; k < 14000; ++k) {
@@ -37,7 +38,7 @@ TEST(FaultAllocation, NoHeapAllocationPerSample) {
     ext.feedback = sup.view().feedback;
     injector.prepare(ext, t);
     const auto& s = sim.step(0.001, ext);
-    const CornerReading r = test::reading_from(s);
+    const CornerReading r = test::reading_from(s, wire);
     const CornerView& v = sup.on_sample(r, t);
     sup.tick(t);
     cap[0] = {v.available, v.force_limit_kN};

@@ -42,11 +42,19 @@ struct CornerPlan {
   calibration::Curve curve;                            // for feedback == Curve
 };
 
+// How the CCU shares the demand when a corner is unavailable. The product always redistributes
+// and counts a held force; the switches exist to measure what each reaction is worth (the
+// closed-loop tests compare against a CCU without it).
+struct ReactionPolicy {
+  bool redistribute = true;      // false: keep the nominal split whatever the corners' state
+  bool count_held_force = true;  // false: a corner that does not release counts as braking 0
+};
+
 class CcuCore {
  public:
   // Throws std::invalid_argument (corner names not FL/FR/RL/RR, twice, bad configs).
   CcuCore(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator,
-          const faults::MonitorParams& monitor = {});
+          const faults::MonitorParams& monitor = {}, ReactionPolicy policy = {});
 
   bool has(std::size_t slot) const { return supervisors_[slot] != nullptr; }
   // The scenario index of the corner in `slot`.
@@ -66,6 +74,7 @@ class CcuCore {
 
  private:
   const scenario::Scenario& scenario_;
+  ReactionPolicy policy_;
   CommandPlanner planner_;
   std::array<std::unique_ptr<faults::CornerSupervisor>, kSlots> supervisors_;
   std::array<std::size_t, kSlots> scenario_index_{};

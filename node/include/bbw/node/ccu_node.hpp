@@ -76,6 +76,10 @@ struct CornerChannel {
   std::array<faults::Diagnosis, 5> seen{};  // last diagnoses recorded (detection log)
 };
 
+// What the CCU reads from a received sample (the one conversion of the wire sample to the
+// supervisor's reading; the force command only when the corner is in force mode).
+faults::CornerReading reading_from(const msg::MeasurementSample& sample);
+
 class CcuObserver {
  public:
   virtual ~CcuObserver() = default;
@@ -90,7 +94,9 @@ class CcuObserver {
 class CcuNode {
  public:
   // Throws std::invalid_argument (corner names not FL/FR/RL/RR, twice, bad configs, period ratio).
-  CcuNode(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator, bool friction_feedback);
+  // `monitor` and `policy` go to CcuCore (defaults: the product's).
+  CcuNode(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator, bool friction_feedback,
+          const faults::MonitorParams& monitor = {}, ccu::ReactionPolicy policy = {});
   CcuNode(const CcuNode&) = delete;
   CcuNode& operator=(const CcuNode&) = delete;
 
