@@ -25,14 +25,16 @@ std::string bytes_text(double b) {
 
 void check_four_corner_run(const Scenario& s) {
   std::set<std::string> seen;
-  for (const CornerSpec& c : s.corners) {
+  for (std::size_t i = 0; i < s.corners.size(); ++i) {
+    const CornerSpec& c = s.corners[i];
+    const std::string key = "corners[" + std::to_string(i) + "].name";
     if (c.name != "FL" && c.name != "FR" && c.name != "RL" && c.name != "RR") {
-      throw config::ConfigError(s.file, c.line, "corners.name",
+      throw config::ConfigError(s.file, c.line, key,
                                 "'" + c.name + "' is not a corner of a four-corner run (FL, FR, RL, RR); this "
                                 "scenario is for ./bbw simulate, not ./bbw run");
     }
     if (!seen.insert(c.name).second) {
-      throw config::ConfigError(s.file, c.line, "corners.name", "corner '" + c.name + "' is listed twice");
+      throw config::ConfigError(s.file, c.line, key, "corner '" + c.name + "' is listed twice");
     }
   }
   if (s.corners.empty()) throw config::ConfigError(s.file, 0, "corners", "a run needs at least one corner");

@@ -53,7 +53,7 @@ std::string error_of(F f) {
 TEST(RunChecks, PaperRigSweepIsNotAFourCornerRun) {
   const auto s = scenario::load_scenario(source_dir() + "/config/scenarios/paper_rig_sweep.yaml");
   const std::string e = error_of([&] { scenario::check_four_corner_run(s); });
-  EXPECT_NE(e.find("paper_rig_sweep.yaml:12: key 'corners.name': 'T28' is not a corner of a four-corner run "
+  EXPECT_NE(e.find("paper_rig_sweep.yaml:12: key 'corners[0].name': 'T28' is not a corner of a four-corner run "
                    "(FL, FR, RL, RR)"),
             std::string::npos)
       << e;
@@ -61,6 +61,9 @@ TEST(RunChecks, PaperRigSweepIsNotAFourCornerRun) {
             "<no ConfigError>");
   EXPECT_EQ(error_of([&] { scenario::check_four_corner_run(load(scenario_text("1", "0.001", "ad"))); }),
             "<no ConfigError>");
+  EXPECT_NE(error_of([&] { scenario::check_four_corner_run(load(scenario_text("1", "0.001", "abX"))); })
+                .find("test.yaml:13: key 'corners[2].name': 'X' is not a corner of a four-corner run"),
+            std::string::npos);
   for (const char* f : {"four_corner_rig.yaml", "vehicle_stop.yaml"}) {
     EXPECT_NO_THROW(scenario::check_four_corner_run(scenario::load_scenario(source_dir() + "/config/scenarios/" + f)))
         << f;
