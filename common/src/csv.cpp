@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <unordered_map>
 #include <sys/stat.h>
 
 namespace bbw::csv {
@@ -129,12 +130,16 @@ std::vector<std::string> header_from(std::streambuf& sb, const std::string& name
   if (!any) throw CsvError(name + ": empty file, expected a header row");
   std::vector<std::string> header;
   if (const std::string why = split(line, header); !why.empty()) throw CsvError(where(name, line_no) + "header: " + why);
+  if (header.size() > options.max_columns) {
+    throw CsvError(where(name, line_no) + "header has " + std::to_string(header.size()) +
+                   " columns, more than the limit of " + std::to_string(options.max_columns));
+  }
+  std::unordered_map<std::string, std::size_t> first_field;
   for (std::size_t i = 0; i < header.size(); ++i) {
-    for (std::size_t j = 0; j < i; ++j) {
-      if (header[i] == header[j]) {
-        throw CsvError(where(name, line_no) + "column '" + printable(header[i]) + "' appears twice in the header (fields " +
-                       std::to_string(j + 1) + " and " + std::to_string(i + 1) + ")");
-      }
+    const auto [it, fresh] = first_field.emplace(header[i], i);
+    if (!fresh) {
+      throw CsvError(where(name, line_no) + "column '" + printable(header[i]) + "' appears twice in the header (fields " +
+                     std::to_string(it->second + 1) + " and " + std::to_string(i + 1) + ")");
     }
   }
   return header;

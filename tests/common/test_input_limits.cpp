@@ -167,6 +167,12 @@ TEST(InputLimitsCsv, DuplicateColumnNamesAreRefused) {
             "t.csv:1: column 'x' appears twice in the header (fields 2 and 3)");
   EXPECT_EQ(csv_error([&] { read_text("\n\nt,t\n0,1\n", o); }),
             "t.csv:3: column 't' appears twice in the header (fields 1 and 2)");
+  // Wide headers: at most 1024 columns by default.
+  std::string wide = "t";
+  for (int i = 1; i < 1024; ++i) wide += ",c" + std::to_string(i);  // 1024 columns
+  EXPECT_EQ(csv_error([&] { read_text(wide + ",c1024\n", o); }),
+            "t.csv:1: header has 1025 columns, more than the limit of 1024");
+  EXPECT_EQ(read_text(wide + "\n1" + std::string(1023, ',') + "\n", o).rows(), 1u);
 }
 
 TEST(InputLimitsCsv, TimeThatDoesNotIncreaseIsRefusedWithItsLineOrDroppedWhenAllowed) {

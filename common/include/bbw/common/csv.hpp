@@ -31,6 +31,8 @@ struct ReadOptions {
   // Lines longer than this are rejected (characters); a longer header line is an error. The
   // reader never holds more than this many characters of one line.
   std::size_t max_line_chars = 1 << 16;
+  // A header with more columns than this is refused (tools load a column per name).
+  std::size_t max_columns = 1024;
   // When set (a loaded column), its values must increase strictly from one usable line to the
   // next: a line that does not is an error naming its line number, unless allow_unsorted_time,
   // which drops such lines and counts them in Table::lines_unsorted_time.
