@@ -110,7 +110,7 @@ TEST(AnalyzeCli, RefusesDevicesFifosAndDirectoriesWithOneLine) {
   fs::create_directories(dir);
   ASSERT_EQ(::mkfifo((dir / "fifo.csv").c_str(), 0600), 0);
   const auto t0 = std::chrono::steady_clock::now();
-  for (const std::string input : {std::string("/dev/zero"), (dir / "fifo.csv").string(), dir.string()}) {
+  for (const std::string& input : {std::string("/dev/zero"), (dir / "fifo.csv").string(), dir.string()}) {
     const auto r = run_analyze("--input " + input + " --out " + (dir / "out").string());
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_EQ(r.output.rfind("bbw_analyze: " + input + ": is ", 0), 0u) << r.output;
