@@ -2,7 +2,8 @@
 # bbw-fuzz.sh [SECONDS] [--merge] [--only TARGET]: builds the libFuzzer targets in fuzz/ with
 # clang into build-fuzz/ (BBW_FUZZ_BUILD_DIR) and runs each for SECONDS (default 60).
 #
-# Targets: csv, yaml, calib, scenario (fuzz/src/entry_points.hpp). Each starts from the
+# Targets: csv, yaml, calib, scenario, scenario_alias, csv_quoted (fuzz/src/entry_points.hpp);
+# a target with fuzz/dicts/<target>.dict gets it as its libFuzzer dictionary. Each starts from the
 # committed corpus tests/fuzz_corpus/<target>/ plus its working corpus build-fuzz/corpus/<target>/
 # (kept between runs). A crash, leak, sanitizer report, uncaught exception or timeout stops that
 # target, leaves the input in build-fuzz/artifacts/<target>/ and makes the command fail.
@@ -16,7 +17,7 @@ JOBS="${BBW_JOBS:-2}"
 SECONDS_PER_TARGET=60
 MERGE=0
 ONLY=""
-TARGETS=(csv yaml calib scenario)
+TARGETS=(csv yaml calib scenario scenario_alias csv_quoted)
 
 die() { echo "bbw fuzz: $*" >&2; exit 1; }
 
@@ -40,7 +41,8 @@ cmake -S "$ROOT/fuzz" -B "$BUILD" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYP
 cmake --build "$BUILD" -j "$JOBS" >/dev/null || { cmake --build "$BUILD" -j 1; die "build failed"; }
 
 # Inputs above this are not interesting for line-based readers and only slow the search.
-max_len() { case "$1" in csv) echo 4096 ;; *) echo 8192 ;; esac; }
+max_len() { case "$1" in csv|csv_quoted) echo 4096 ;; *) echo 8192 ;; esac; }
+dict_arg() { [ -f "$ROOT/fuzz/dicts/$1.dict" ] && echo "-dict=$ROOT/fuzz/dicts/$1.dict" || true; }
 
 failed=()
 summary=()
@@ -54,7 +56,7 @@ for t in "${TARGETS[@]}"; do
   set +e
   # -timeout: one input taking more than 10 s is a finding (a hang); -rss_limit_mb bounds memory.
   ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=1" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
-    "$BUILD/fuzz_$t" -max_total_time="$SECONDS_PER_TARGET" -max_len="$(max_len "$t")" -timeout=10 \
+    "$BUILD/fuzz_$t" -max_total_time="$SECONDS_PER_TARGET" -max_len="$(max_len "$t")" -timeout=10 $(dict_arg "$t") \
     -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$art/" "$work" "$seeds" >"$log" 2>&1
   rc=$?
   set -e

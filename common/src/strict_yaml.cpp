@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 
 #include <cmath>
+#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -46,7 +47,81 @@ const char* type_name(const YAML::Node& n) {
   }
 }
 
+// Walks a parsed document the way a reader would see it (aliases expanded) and stops at the
+// first limit passed. Recursion is bounded by limits.max_depth.
+class DocumentWalk {
+ public:
+  DocumentWalk(const std::string& file, const DocumentLimits& limits) : file_(file), limits_(limits) {}
+
+  void visit(const YAML::Node& n, std::size_t depth) {
+    if (++nodes_ > limits_.max_nodes) {
+      fail(n, "document has more than " + std::to_string(limits_.max_nodes) +
+                  " nodes when its aliases are expanded (each use of an alias counts its whole value again)");
+    }
+    if (depth > limits_.max_depth) {
+      fail(n, "nested deeper than " + std::to_string(limits_.max_depth) + " levels (or an alias refers to itself)");
+    }
+    switch (n.Type()) {
+      case YAML::NodeType::Scalar:
+        scalar_chars_ += n.Scalar().size();
+        if (scalar_chars_ > kMaxScalarChars) {
+          fail(n, "document holds more than " + std::to_string(kMaxScalarChars) +
+                      " characters of values when its aliases are expanded");
+        }
+        break;
+      case YAML::NodeType::Sequence: {
+        if (n.size() > limits_.max_list_entries) {
+          fail(n, "list has " + std::to_string(n.size()) + " entries, more than the limit of " +
+                      std::to_string(limits_.max_list_entries));
+        }
+        std::size_t i = 0;
+        for (const auto& item : n) {
+          const std::size_t mark = path_.size();
+          path_ += "[" + std::to_string(i++) + "]";
+          visit(item, depth + 1);
+          path_.resize(mark);
+        }
+        break;
+      }
+      case YAML::NodeType::Map: {
+        if (n.size() > limits_.max_list_entries) {
+          fail(n, "mapping has " + std::to_string(n.size()) + " keys, more than the limit of " +
+                      std::to_string(limits_.max_list_entries));
+        }
+        for (const auto& kv : n) {
+          const std::size_t mark = path_.size();
+          visit(kv.first, depth + 1);
+          path_ += (path_.empty() ? "" : ".") + (kv.first.IsScalar() ? kv.first.Scalar() : std::string("?"));
+          visit(kv.second, depth + 1);
+          path_.resize(mark);
+        }
+        break;
+      }
+      default:
+        break;
+    }
+  }
+
+ private:
+  // Expanded characters of all scalars; the file itself is at most kMaxConfigBytes.
+  static constexpr std::size_t kMaxScalarChars = 16u << 20;
+
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& rule) const {
+    throw ConfigError(file_, mark_line(n), path_, rule);
+  }
+
+  const std::string& file_;
+  const DocumentLimits& limits_;
+  std::size_t nodes_ = 0;
+  std::size_t scalar_chars_ = 0;
+  std::string path_;
+};
+
 }  // namespace
+
+void check_document(const YAML::Node& root, const std::string& file, const DocumentLimits& limits) {
+  DocumentWalk(file, limits).visit(root, 0);
+}
 
 ConfigError::ConfigError(const std::string& file, int line, const std::string& key_path,
                          const std::string& rule)
@@ -94,7 +169,7 @@ Reader::Reader(YAML::Node node, std::string file, std::string path)
   }
 }
 
-Reader Reader::from_file(const std::string& file) {
+Reader Reader::from_file(const std::string& file, const DocumentLimits& limits) {
   // Refuse what is not a small regular file before yaml-cpp opens it: a directory makes it
   // throw std::ios_base::failure, a FIFO or a device would block or never end.
   struct stat st {};
@@ -104,21 +179,33 @@ Reader Reader::from_file(const std::string& file) {
     throw ConfigError(file, 0, "", "file is " + std::to_string(st.st_size) + " bytes, more than the limit of " +
                                        std::to_string(kMaxConfigBytes));
   }
+  std::string text;
+  {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw ConfigError(file, 0, "", "cannot open file");
+    // Read at most one byte past the limit: the file may have grown since stat().
+    text.resize(kMaxConfigBytes + 1);
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<std::size_t>(in.gcount()));
+    if (in.bad()) throw ConfigError(file, 0, "", "cannot read file");
+    if (text.size() > kMaxConfigBytes) {
+      throw ConfigError(file, 0, "", "file is more than the limit of " + std::to_string(kMaxConfigBytes) + " bytes");
+    }
+  }
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(file, 0, "", "cannot open file");
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw ConfigError(file, e.mark.line >= 0 ? e.mark.line + 1 : 0, "",
                       "YAML syntax error: " + e.msg);
   } catch (const std::exception& e) {
     throw ConfigError(file, 0, "", std::string("cannot read file: ") + e.what());
   }
+  check_document(root, file, limits);
   return Reader(root, file, "");
 }
 
-Reader Reader::from_string(const std::string& text, const std::string& name) {
+Reader Reader::from_string(const std::string& text, const std::string& name, const DocumentLimits& limits) {
   if (text.size() > kMaxConfigBytes) {
     throw ConfigError(name, 0, "", "text is " + std::to_string(text.size()) + " bytes, more than the limit of " +
                                        std::to_string(kMaxConfigBytes));
@@ -130,6 +217,7 @@ Reader Reader::from_string(const std::string& text, const std::string& name) {
     throw ConfigError(name, e.mark.line >= 0 ? e.mark.line + 1 : 0, "",
                       "YAML syntax error: " + e.msg);
   }
+  check_document(root, name, limits);
   return Reader(root, name, "");
 }
 

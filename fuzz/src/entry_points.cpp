@@ -3,11 +3,13 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <variant>
 
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/common/csv.hpp"
 #include "bbw/common/strict_yaml.hpp"
 #include "bbw/scenario/load.hpp"
+#include "bbw/scenario/run_checks.hpp"
 
 namespace bbw::fuzz {
 
@@ -133,12 +135,98 @@ Outcome scenario(const std::uint8_t* data, std::size_t size, const std::string& 
   }
 }
 
+// The head every scenario_alias input continues: anchors a whole drive, a list of levels and
+// a segment mapping, all valid, for the input to alias (or redefine) in any way. The input
+// starts inside the first corner's mapping, so it can add keys, more corners, or top-level keys.
+const char kAliasHead[] =
+    "name: alias\n"
+    "seed: 1\n"
+    "duration_s: 2\n"
+    "plant: ../plant/ecaliper.yaml\n"
+    "corners:\n"
+    "  - name: FL\n"
+    "    temperature_C: 20\n"
+    "    drive: &drive\n"
+    "      mode: position\n"
+    "      segments:\n"
+    "        - &segment {type: local_loops, levels_rev: &levels [1, 2, 3], amplitude_rev: 0.2, period_s: 1}\n"
+    "        - {type: steps, levels_rev: *levels, hold_s: 0.1}\n";
+
+Outcome scenario_alias(const std::uint8_t* data, std::size_t size, const std::string& source_dir) {
+  const std::string doc = kAliasHead + text(data, size);
+  try {
+    const scenario::Scenario s = scenario::load_scenario_string(doc, source_dir + "/config/scenarios/fuzz.yaml");
+    require(!s.corners.empty(), "accepted a scenario without corners");
+    // What a loader may hold is bounded by the document limits: the position profile's levels
+    // come from lists of at most 20 000 entries, in at most 200 000 nodes.
+    std::size_t levels = 0;
+    for (const auto& c : s.corners) {
+      for (const auto& seg : c.drive.position.segments) {
+        if (const auto* l = std::get_if<scenario::LocalLoops>(&seg)) levels += l->levels_rev.size();
+        if (const auto* st = std::get_if<scenario::Steps>(&seg)) levels += st->levels_rev.size();
+      }
+    }
+    require(levels <= config::DocumentLimits{}.max_nodes, "loaded more levels than the document may hold");
+    const scenario::RunEstimate e = scenario::estimate_run(s);
+    require(e.samples >= e.plant_steps && e.output_bytes > 0, "inconsistent run estimate");
+    try {
+      scenario::check_four_corner_run(s);
+      scenario::check_run_size(s);
+    } catch (const config::ConfigError&) {
+      // refused for a run: the documented outcome
+    }
+    return Outcome::Accepted;
+  } catch (const config::ConfigError&) {
+    return Outcome::Rejected;
+  }
+}
+
+Outcome csv_quoted(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return Outcome::Rejected;
+  const std::uint8_t mode = data[0];
+  std::string body = text(data + 1, size - 1);
+  if (mode & 1) body = "\xEF\xBB\xBF" + body;
+  csv::ReadOptions o;
+  o.required = {"t_s", "x"};
+  o.optional = {"a,b", "q\"q"};  // names only a quoted header can hold
+  o.max_line_chars = 256;
+  if (mode & 2) o.time_column = "t_s";
+  o.allow_unsorted_time = (mode & 4) != 0;
+  std::istringstream in(body);
+  try {
+    const csv::Table t = csv::read_stream(in, "fuzz.csv", o);
+    require(t.rows() > 0, "accepted a table without rows");
+    for (const auto& c : t.values) {
+      require(c.size() == t.rows(), "columns of different lengths");
+      for (double v : c) require(std::isfinite(v), "accepted a non-finite value");
+    }
+    require(t.rows() + t.lines_rejected + t.lines_unsorted_time == t.lines_read,
+            "rows + rejected + dropped != lines read");
+    if (!o.time_column.empty()) {
+      const auto& ts = t.column("t_s");
+      for (std::size_t i = 1; i < ts.size(); ++i) require(ts[i] > ts[i - 1], "accepted time that does not increase");
+    } else {
+      require(t.lines_unsorted_time == 0, "dropped lines without a time column");
+    }
+    const std::string summary = t.rejection_summary();
+    for (const char c : summary) require(c >= 0x20 && c < 0x7f, "non-printable byte in the rejection summary");
+    return Outcome::Accepted;
+  } catch (const csv::CsvError& e) {
+    for (const char* p = e.what(); *p; ++p) {
+      require(*p >= 0x20 && *p < 0x7f, "non-printable byte in a CSV error message");
+    }
+    return Outcome::Rejected;
+  }
+}
+
 const std::vector<Target>& targets() {
   static const std::vector<Target> t{
       {"csv", [](const std::uint8_t* d, std::size_t n, const std::string&) { return csv(d, n); }},
       {"yaml", [](const std::uint8_t* d, std::size_t n, const std::string&) { return yaml(d, n); }},
       {"calib", [](const std::uint8_t* d, std::size_t n, const std::string&) { return calib(d, n); }},
       {"scenario", scenario},
+      {"scenario_alias", scenario_alias},
+      {"csv_quoted", [](const std::uint8_t* d, std::size_t n, const std::string&) { return csv_quoted(d, n); }},
   };
   return t;
 }

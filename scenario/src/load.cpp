@@ -170,8 +170,13 @@ corner_unit::ControllerParams read_controller(Reader& c) {
 
 CornerSpec read_corner(Reader& c, const Scenario& sc) {
   CornerSpec k;
+  k.line = c.line();
   k.name = c.string("name");
-  if (k.name.empty()) c.fail("name", "must not be empty");
+  // The name becomes part of file names (DIR/<name>.csv, corner_<name>.stats): no path tricks.
+  const bool plain = !k.name.empty() && k.name.size() <= 32 &&
+                     k.name.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") ==
+                         std::string::npos;
+  if (!plain) c.fail("name", "must be 1 to 32 letters, digits, '_' or '-'");
   if (c.has("axle")) {
     k.axle = c.choice("axle", {"front", "rear"}) == "front" ? Axle::Front : Axle::Rear;
   } else {
@@ -212,6 +217,7 @@ Scenario read_scenario(Reader& r, const ExtraKeys& extra) {
   if (s.name.empty()) r.fail("name", "must not be empty");
   s.seed = static_cast<std::uint64_t>(r.integer("seed", 0, std::numeric_limits<std::int64_t>::max()));
   s.duration_s = r.number("duration_s", Range{0.0, 1.0e5, true, false});
+  s.duration_line = line_of(r.node()["duration_s"]);
   s.plant_dt_s = r.number_or("plant_dt_s", 0.001, Range::closed(1.0e-5, 0.01));
   s.ccu_period_s = r.number_or("ccu_period_s", 0.005, Range::closed(1.0e-4, 1.0));
   if (s.ccu_period_s < s.plant_dt_s) r.fail("ccu_period_s", "must be >= plant_dt_s");

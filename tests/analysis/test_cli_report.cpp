@@ -1,8 +1,17 @@
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "bbw/common/csv.hpp"
 
 #include "bbw/analyze/cli.hpp"
 #include "bbw/analyze/report.hpp"
@@ -70,5 +79,85 @@ TEST(AnalyzeCli, WritesJsonReportAndPlots) {
   }
   for (const char* f : {"report.md", "residual_time.png", "residual_vs_regressor.png", "truth_error_time.png"})
     EXPECT_GT(fs::file_size(dir / "out" / f), 100u) << f;
+  fs::remove_all(dir);
+}
+
+namespace {
+
+struct ToolRun {
+  int exit_code;
+  std::string output;
+};
+
+ToolRun run_analyze(const std::string& args) {
+  const std::string cmd = std::string(BBW_BINARY_DIR_FALLBACK) + "/bin/bbw_analyze " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[512];
+  while (p && fgets(buf, sizeof buf, p)) out += buf;
+  const int status = p ? pclose(p) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+}  // namespace
+
+// Issue 17: the input is checked for its kind before anything reads it (the header was read
+// first: /dev/zero grew to 10.6 GB, a FIFO without a writer hung), and a data error is one line.
+TEST(AnalyzeCli, RefusesDevicesFifosAndDirectoriesWithOneLine) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("bbw_analyze_kinds_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  ASSERT_EQ(::mkfifo((dir / "fifo.csv").c_str(), 0600), 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (const std::string& input : {std::string("/dev/zero"), (dir / "fifo.csv").string(), dir.string()}) {
+    const auto r = run_analyze("--input " + input + " --out " + (dir / "out").string());
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_EQ(r.output.rfind("bbw_analyze: " + input + ": is ", 0), 0u) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 20.0);
+  // Garbage bytes are escaped, and a missing column is one line too (exit 2, no usage).
+  {
+    std::ofstream f(dir / "junk.csv", std::ios::binary);
+    f << "\x1b[31m\xff,b\n1,2\n";
+  }
+  auto r = run_analyze("--input " + (dir / "junk.csv").string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("header has: \\x1B[31m\\xFF, b"), std::string::npos) << r.output;
+  for (const char c : r.output) EXPECT_TRUE(c == '\n' || (c >= 0x20 && c < 0x7f)) << r.output;
+  EXPECT_EQ(r.output.find("usage"), std::string::npos) << r.output;
+  r = run_analyze("--input " + (dir / "junk.csv").string() + " --out " + (dir / "out").string() + " --truth nope");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(r.output, "bbw_analyze: " + (dir / "junk.csv").string() + ": no column 'nope'\n");
+  // Argument errors still show the usage.
+  r = run_analyze("--bogus");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("usage: bbw_analyze"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
+// The same reader as calibrate: a BOM and a quoted header are accepted; time must increase.
+TEST(AnalyzeCli, QuotedHeaderWithBomAndUnsortedTime) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("bbw_analyze_quoted_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  {
+    std::ofstream f(dir / "q.csv", std::ios::binary);
+    f << "\xEF\xBB\xBF\"time_s\",\"position_rev\",\"force_internal_kN\"\n0,1,2\n0.1,1,2\n0.1,1,2\n0.2,1,2\n";
+  }
+  analyze::CliArgs a = analyze::parse_args({"--input", (dir / "q.csv").string(), "--out", (dir / "o").string()});
+  try {
+    analyze::load_recording(a);
+    ADD_FAILURE() << "time that does not increase was accepted";
+  } catch (const csv::CsvError& e) {
+    EXPECT_NE(std::string(e.what()).find("q.csv:4: time 'time_s' does not increase"), std::string::npos) << e.what();
+  }
+  a = analyze::parse_args(
+      {"--input", (dir / "q.csv").string(), "--out", (dir / "o").string(), "--allow-unsorted-time"});
+  const auto in = analyze::load_recording(a);
+  EXPECT_EQ(in.rec.time_s, (std::vector<double>{0, 0.1, 0.2}));
+  EXPECT_EQ(in.lines_unsorted_time, 1u);
+  EXPECT_TRUE(in.channel_cols.empty());
   fs::remove_all(dir);
 }

@@ -4,6 +4,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -182,4 +183,89 @@ TEST(CalibrateCli, TemperatureColumnFeedsTheThermalOffsetTerm) {
   EXPECT_EQ(read_file(dir / "without" / "summary.json").find(expected), std::string::npos) << expected;
   EXPECT_NE(run(common + " --out " + (dir / "x").string() + " --temperature nope").output.find("'nope'"),
             std::string::npos);
+}
+
+// Honest failure (issue 17): a recording too short for a fit gives exit 1 naming the reason, a
+// summary with status failed and null errors (not 0), and no plot.
+TEST(CalibrateCli, NoAcceptedFitFailsWithTheReasonAndNullErrors) {
+  const auto dir = temp_dir("calibrate_cli_nofit");
+  {
+    std::ofstream f(dir / "four.csv");
+    f << "time_s,position_rev,force_internal_kN,force_external_kN\n0,0,0,0\n0.001,0.1,0.2,0.2\n0.002,0.2,0.4,0.4\n"
+         "0.003,0.3,0.6,0.6\n";
+  }
+  const auto out = dir / "out";
+  const auto r = run("--input " + (dir / "four.csv").string() + " --out " + out.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("calibration failed: no fit accepted (0 cycles detected"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("gnuplot"), std::string::npos) << r.output;
+  const std::string summary = read_file(out / "summary.json");
+  for (const char* key : {"\"status\": \"failed\"", "\"reason\": \"no fit accepted", "\"max_abs_error_kN\": null",
+                          "\"rms_error_kN\": null", "\"samples_scored\": 0",
+                          "\"not_scored_reason\": \"no fit accepted, so no estimate to score\""}) {
+    EXPECT_NE(summary.find(key), std::string::npos) << key << "\n" << summary;
+  }
+  for (const char* png : {"force_position.png", "estimate_time.png", "error_time.png"}) {
+    EXPECT_FALSE(fs::exists(out / png)) << png;
+  }
+}
+
+// One CSV reader: time that does not increase is refused with its line number, or dropped and
+// counted with --allow-unsorted-time; a BOM and quoted header are fine; duplicates are refused.
+TEST(CalibrateCli, UnsortedTimeBomAndDuplicateColumns) {
+  const auto dir = temp_dir("calibrate_cli_csv");
+  const auto csv = write_recording(dir, false);
+  std::string body = read_file(csv);
+  body.erase(0, body.find('\n') + 1);
+  const std::string dup_line = body.substr(0, body.find('\n') + 1);  // the first data line again
+  {
+    std::ofstream f(dir / "unsorted.csv");
+    f << "\xEF\xBB\xBF\"t\",\"x\",\"f_int\",\"f_ext\"\n" << body.substr(0, 1000) << body.substr(1000, body.size() - 1000);
+    f << dup_line;  // time jumps back at the end: line 34002
+  }
+  const std::string cols = " --time t --position x --force f_int --truth f_ext";
+  auto r = run("--input " + (dir / "unsorted.csv").string() + " --out " + (dir / "o1").string() + cols);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("unsorted.csv:34002: time 't' does not increase"), std::string::npos) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;  // one line, no usage
+  r = run("--input " + (dir / "unsorted.csv").string() + " --out " + (dir / "o2").string() + cols +
+          " --allow-unsorted-time");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("dropped 1 whose time did not increase (first: line 34002)"), std::string::npos) << r.output;
+  EXPECT_NE(read_file(dir / "o2" / "summary.json").find("\"lines_unsorted_time_dropped\": 1"), std::string::npos);
+  {
+    std::ofstream f(dir / "dup.csv");
+    f << "t,x,f_int,x\n0,1,2,3\n";
+  }
+  r = run("--input " + (dir / "dup.csv").string() + " --out " + (dir / "o3").string() + cols);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("dup.csv:1: column 'x' appears twice in the header (fields 2 and 4)"), std::string::npos)
+      << r.output;
+}
+
+// A plotting failure names what failed and leaves no PNG (gnuplot cannot be found here).
+TEST(CalibrateCli, PlotFailureNamesWhatFailedAndLeavesNoPng) {
+  const auto dir = temp_dir("calibrate_cli_plotfail");
+  const auto csv = write_recording(dir, false);
+  const auto out = dir / "out";
+  const std::string cmd = "/usr/bin/env PATH=/nonexistent " + std::string(BBW_BINARY_DIR_FALLBACK) +
+                          "/bin/bbw_calibrate --input " + csv.string() + " --out " + out.string() +
+                          " --time t --position x --force f_int --truth f_ext 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string text;
+  char buf[512];
+  while (fgets(buf, sizeof buf, p)) text += buf;
+  const int status = pclose(p);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1) << text;
+  EXPECT_NE(text.find("plots: gnuplot could not be started (is gnuplot installed? ./bbw setup) on " +
+                      (out / "plots.gp").string()),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("not written: " + (out / "force_position.png").string()), std::string::npos) << text;
+  for (const char* png : {"force_position.png", "estimate_time.png", "error_time.png"}) {
+    EXPECT_FALSE(fs::exists(out / png)) << png;
+  }
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
 }

@@ -1,4 +1,5 @@
 // bbw_calibrate: the calibrator offline over a CSV recording (./bbw calibrate).
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <cstring>
@@ -16,15 +17,18 @@ namespace {
 const char* kUsage =
     "usage: bbw_calibrate --input FILE.csv [--config FILE.yaml] --out DIR\n"
     "                     [--time COL] [--position COL] [--force COL] [--truth COL] [--speed COL]\n"
-    "                     [--temperature COL]\n"
+    "                     [--temperature COL] [--allow-unsorted-time]\n"
     "  Runs the calibrator over a recording. Default columns: time_s, position_rev,\n"
-    "  force_internal_kN; truth: force_external_kN, speed: speed_rev_s and temperature: temperature_C when present.\n";
+    "  force_internal_kN; truth: force_external_kN, speed: speed_rev_s and temperature: temperature_C when present.\n"
+    "  Time must increase strictly; --allow-unsorted-time drops the lines where it does not and counts them.\n"
+    "  Exit: 0 calibrated, 1 an error or no fit accepted (summary.json says why), 2 bad arguments.\n";
 
 struct Args {
   std::string input, config = BBW_DEFAULT_CALIBRATOR_CONFIG, out;
   std::string time_col = "time_s", position_col = "position_rev", force_col = "force_internal_kN";
   std::string truth_col, speed_col, temperature_col;
   bool truth_given = false, speed_given = false, temperature_given = false;
+  bool allow_unsorted_time = false;
 };
 
 bool parse(int argc, char** argv, Args& a) {
@@ -43,6 +47,7 @@ bool parse(int argc, char** argv, Args& a) {
     else if (k == "--truth") { next(a.truth_col); a.truth_given = true; }
     else if (k == "--speed") { next(a.speed_col); a.speed_given = true; }
     else if (k == "--temperature") { next(a.temperature_col); a.temperature_given = true; }
+    else if (k == "--allow-unsorted-time") a.allow_unsorted_time = true;
     else if (k == "-h" || k == "--help") { std::cout << kUsage; std::exit(0); }
     else throw std::invalid_argument("unknown argument '" + k + "'");
   }
@@ -94,8 +99,12 @@ int main(int argc, char** argv) {
     else ro.optional.push_back("speed_rev_s");
     if (a.temperature_given) ro.required.push_back(a.temperature_col);
     else ro.optional.push_back("temperature_C");
+    ro.time_column = a.time_col;
+    ro.allow_unsorted_time = a.allow_unsorted_time;
     const auto table = bbw::csv::read(a.input, ro);
-    if (table.lines_rejected > 0) std::cerr << "bbw_calibrate: " << a.input << ": " << table.rejection_summary() << "\n";
+    if (table.lines_rejected > 0 || table.lines_unsorted_time > 0) {
+      std::cerr << "bbw_calibrate: " << a.input << ": " << table.rejection_summary() << "\n";
+    }
     const std::string truth_col = a.truth_given ? a.truth_col : (table.has("force_external_kN") ? "force_external_kN" : "");
 
     bbw::calibration::Recording rec;
@@ -140,16 +149,38 @@ int main(int argc, char** argv) {
       }
       w.close();
     }
+    // Honest outcome: no accepted fit is a failed calibration; an error over no scored sample
+    // is not a number (null in JSON), and the summary says why.
+    std::string failure;
+    if (res.stats.fits_accepted == 0) {
+      failure = "no fit accepted (" + std::to_string(res.stats.cycles_detected) + " cycles detected, " +
+                std::to_string(res.stats.fits_rejected) + " fits rejected, " + std::to_string(rec.time_s.size()) +
+                " samples): the recording does not excite a calibration cycle";
+    }
+    std::string not_scored;
+    if (!has_truth) not_scored = "no truth column";
+    else if (res.score.samples_scored == 0) {
+      not_scored = res.stats.fits_accepted == 0 ? "no fit accepted, so no estimate to score"
+                                                : "no valid estimate after the first accepted fit";
+    }
+    const double nan = std::nan("");
     bbw::json::Writer j;
     j.begin_object();
+    j.value("status", failure.empty() ? "calibrated" : "failed");
+    if (!failure.empty()) j.value("reason", failure);
     j.value("input", a.input).value("config", a.config).value("mode", bbw::calibration::to_string(config.mode));
     j.value("samples", rec.time_s.size()).value("lines_rejected", table.lines_rejected);
+    j.value("lines_unsorted_time_dropped", table.lines_unsorted_time);
     j.value("samples_rejected_by_calibrator", static_cast<long long>(res.stats.samples_rejected));
     j.value("truth_column", truth_col);
     if (has_truth) {
-      j.value("max_abs_error_kN", res.score.max_abs_error_kN).value("rms_error_kN", res.score.rms_error_kN);
-      j.value("max_error_pct_fs", res.score.max_error_pct_fs).value("time_of_max_error_s", res.score.time_of_max_error_s);
+      const bool scored = not_scored.empty();
+      j.value("max_abs_error_kN", scored ? res.score.max_abs_error_kN : nan)
+          .value("rms_error_kN", scored ? res.score.rms_error_kN : nan);
+      j.value("max_error_pct_fs", scored ? res.score.max_error_pct_fs : nan)
+          .value("time_of_max_error_s", scored ? res.score.time_of_max_error_s : nan);
     }
+    if (!not_scored.empty()) j.value("not_scored_reason", not_scored);
     j.value("full_scale_kN", config.full_scale_kN);
     j.value("samples_scored", res.score.samples_scored).value("warmup_s", res.score.warmup_s);
     j.value("cycles_detected", static_cast<long long>(res.stats.cycles_detected));
@@ -167,14 +198,28 @@ int main(int argc, char** argv) {
         .end_object();
     j.end_object();
     j.save(a.out + "/summary.json");
-    write_plots(a.out, has_truth);
+    if (!failure.empty()) {
+      std::cerr << "bbw_calibrate: " << a.input << ": calibration failed: " << failure << " (wrote " << a.out
+                << "/summary.json, no plots)\n";
+      return 1;
+    }
+    try {
+      write_plots(a.out, has_truth);
+    } catch (const std::exception& e) {
+      std::cerr << "bbw_calibrate: plots: " << e.what() << " (summary.json and the CSV files are written)\n";
+      return 1;
+    }
     std::printf("bbw_calibrate: %s mode, %zu samples, %llu cycles, %llu fits accepted, %llu rejected",
                 bbw::calibration::to_string(config.mode), rec.time_s.size(),
                 static_cast<unsigned long long>(res.stats.cycles_detected),
                 static_cast<unsigned long long>(res.stats.fits_accepted),
                 static_cast<unsigned long long>(res.stats.fits_rejected));
-    if (has_truth) std::printf(", max |error| %.4f kN (%.3f %% FS), RMS %.4f kN", res.score.max_abs_error_kN,
-                               res.score.max_error_pct_fs, res.score.rms_error_kN);
+    if (has_truth && not_scored.empty()) {
+      std::printf(", max |error| %.4f kN (%.3f %% FS), RMS %.4f kN", res.score.max_abs_error_kN,
+                  res.score.max_error_pct_fs, res.score.rms_error_kN);
+    } else if (has_truth) {
+      std::printf(", error not scored (%s)", not_scored.c_str());
+    }
     std::printf("\nbbw_calibrate: wrote %s/summary.json, estimates.csv and plots\n", a.out.c_str());
     return 0;
   } catch (const std::exception& e) {

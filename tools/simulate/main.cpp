@@ -1,4 +1,4 @@
-// bbw_simulate SCENARIO.yaml --out DIR [--no-plot]
+// bbw_simulate SCENARIO.yaml --out DIR [--no-plot] [--allow-large]
 // Runs every corner of the scenario (plant + local controller, no DDS) for duration_s at
 // plant_dt_s and writes DIR/<corner>.csv and DIR/<corner>.png (load-cell and external force
 // against position, a paper Fig. 5 look-alike).
@@ -13,6 +13,7 @@
 #include "bbw/common/plot.hpp"
 #include "bbw/scenario/corner_sim.hpp"
 #include "bbw/scenario/load.hpp"
+#include "bbw/scenario/run_checks.hpp"
 
 namespace {
 
@@ -24,9 +25,10 @@ const std::vector<std::string> kColumns = {
 int usage(const char* why) {
   if (why) std::fprintf(stderr, "bbw_simulate: %s\n", why);
   std::fprintf(stderr,
-               "usage: bbw_simulate SCENARIO.yaml --out DIR [--no-plot]\n"
+               "usage: bbw_simulate SCENARIO.yaml --out DIR [--no-plot] [--allow-large]\n"
                "  writes DIR/<corner>.csv (columns: time_s, position_rev, force_internal_kN,\n"
-               "  force_external_kN, temperature_C, ...) and DIR/<corner>.png per corner\n");
+               "  force_external_kN, temperature_C, ...) and DIR/<corner>.png per corner;\n"
+               "  --allow-large accepts a run over the size limits (docs/security.md, \"Inputs\")\n");
   return 2;
 }
 
@@ -53,6 +55,7 @@ int main(int argc, char** argv) {
   std::string scenario_file;
   std::string out_dir;
   bool plot = true;
+  bool allow_large = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--out") {
@@ -60,6 +63,8 @@ int main(int argc, char** argv) {
       out_dir = argv[++i];
     } else if (a == "--no-plot") {
       plot = false;
+    } else if (a == "--allow-large") {
+      allow_large = true;
     } else if (a == "-h" || a == "--help") {
       usage(nullptr);
       return 0;
@@ -76,6 +81,7 @@ int main(int argc, char** argv) {
 
   try {
     const bbw::scenario::Scenario sc = bbw::scenario::load_scenario(scenario_file);
+    if (!allow_large) bbw::scenario::check_run_size(sc);
     std::filesystem::create_directories(out_dir);
     const auto steps = static_cast<long long>(std::llround(sc.duration_s / sc.plant_dt_s));
     for (std::size_t c = 0; c < sc.corners.size(); ++c) {

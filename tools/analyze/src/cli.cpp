@@ -1,7 +1,6 @@
 #include "bbw/analyze/cli.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -13,10 +12,12 @@ std::string usage() {
   return "usage: bbw_analyze --input FILE.csv --out DIR [--config FILE.yaml]\n"
          "         [--time COL] [--position COL] [--force COL] [--truth COL|none]\n"
          "         [--temperature COL|none] [--velocity COL] [--acceleration COL]\n"
-         "         [--channels A,B,...|none]\n"
+         "         [--channels A,B,...|none] [--allow-unsorted-time]\n"
          "defaults: time_s (or t_s), position_rev, force_internal_kN, truth force_external_kN and\n"
          "temperature temperature_C and velocity speed_rev_s when present; channels: every other\n"
-         "column of the header except those whose name contains 'true' (simulator ground truth).\n";
+         "column of the header except those whose name contains 'true' (simulator ground truth).\n"
+         "Time must increase strictly; --allow-unsorted-time drops the lines where it does not\n"
+         "and counts them.\n";
 }
 
 namespace {
@@ -28,15 +29,6 @@ std::vector<std::string> split_list(const std::string& s) {
   while (std::getline(in, cur, ','))
     if (!cur.empty()) out.push_back(cur);
   return out;
-}
-
-std::vector<std::string> header_of(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw std::invalid_argument(file + ": cannot open");
-  std::string line;
-  std::getline(in, line);
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  return split_list(line);
 }
 
 bool contains(const std::vector<std::string>& v, const std::string& s) {
@@ -63,6 +55,7 @@ CliArgs parse_args(const std::vector<std::string>& args) {
     else if (k == "--temperature") a.temperature_col = next();
     else if (k == "--velocity") a.velocity_col = next();
     else if (k == "--acceleration") a.acceleration_col = next();
+    else if (k == "--allow-unsorted-time") a.allow_unsorted_time = true;
     else if (k == "--channels") {
       a.channels_given = true;
       const std::string v = next();
@@ -83,14 +76,14 @@ std::string unit_from_column(const std::string& column) {
 LoadedRecording load_recording(const CliArgs& a) {
   LoadedRecording L;
   L.file = a.input;
-  const auto header = header_of(a.input);
+  const auto header = csv::read_header(a.input);
   L.time_col = !a.time_col.empty() ? a.time_col : (contains(header, "time_s") || !contains(header, "t_s") ? "time_s" : "t_s");
   L.position_col = a.position_col.empty() ? "position_rev" : a.position_col;
   L.force_col = a.force_col.empty() ? "force_internal_kN" : a.force_col;
   auto optional_default = [&](const std::string& given, const std::string& fallback) -> std::string {
     if (given == "none") return "";
     if (!given.empty()) {
-      if (!contains(header, given)) throw std::invalid_argument(a.input + ": no column '" + given + "'");
+      if (!contains(header, given)) throw std::invalid_argument(a.input + ": no column '" + csv::printable(given) + "'");
       return given;
     }
     return contains(header, fallback) ? fallback : "";
@@ -116,9 +109,12 @@ LoadedRecording load_recording(const CliArgs& a) {
   for (const auto& c : {L.truth_col, L.temperature_col, L.velocity_col, L.acceleration_col})
     if (!c.empty()) o.required.push_back(c);
   for (const auto& c : L.channel_cols) o.required.push_back(c);
+  o.time_column = L.time_col;
+  o.allow_unsorted_time = a.allow_unsorted_time;
   const csv::Table t = csv::read(a.input, o);
   L.lines_read = t.lines_read;
   L.lines_rejected = t.lines_rejected;
+  L.lines_unsorted_time = t.lines_unsorted_time;
   L.rejection_summary = t.rejection_summary();
   auto& r = L.rec;
   r.time_s = t.column(L.time_col);

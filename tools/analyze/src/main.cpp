@@ -16,11 +16,18 @@ int main(int argc, char** argv) {
       std::cout << analyze::usage();
       return 0;
     }
+  analyze::CliArgs cli;
   try {
-    const auto cli = analyze::parse_args(args);
+    cli = analyze::parse_args(args);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "bbw_analyze: " << e.what() << "\n" << analyze::usage();
+    return 2;
+  }
+  // From here on an error is one line (file:line: reason), without the usage text.
+  try {
     const auto opts = cli.config.empty() ? analysis::AnalysisOptions{} : analyze::load_options_file(cli.config);
     const auto in = analyze::load_recording(cli);
-    if (in.lines_rejected > 0) std::cerr << "bbw_analyze: " << in.rejection_summary << "\n";
+    if (in.lines_rejected > 0 || in.lines_unsorted_time > 0) std::cerr << "bbw_analyze: " << in.file << ": " << in.rejection_summary << "\n";
     const auto t0 = std::chrono::steady_clock::now();
     const auto result = analysis::analyze(in.rec, opts);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -36,7 +43,7 @@ int main(int argc, char** argv) {
               << secs << " s; wrote " << cli.out << "/analysis.json\n";
     return 0;
   } catch (const std::invalid_argument& e) {
-    std::cerr << "bbw_analyze: " << e.what() << "\n" << analyze::usage();
+    std::cerr << "bbw_analyze: " << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "bbw_analyze: " << e.what() << "\n";

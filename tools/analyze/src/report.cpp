@@ -73,6 +73,7 @@ std::string analysis_json(const LoadedRecording& in, const analysis::AnalysisOpt
   w.end_array();
   w.value("lines_read", in.lines_read);
   w.value("lines_rejected", in.lines_rejected);
+  w.value("lines_unsorted_time_dropped", in.lines_unsorted_time);
   w.value("samples", r.samples);
   w.value("dt_s", r.dt_s);
   w.value("holdout_samples", r.holdout_samples);

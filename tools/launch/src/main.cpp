@@ -47,6 +47,7 @@
 #include "bbw/launch/signals.hpp"
 #include "bbw/launch/stats_file.hpp"
 #include "bbw/scenario/load.hpp"
+#include "bbw/scenario/run_checks.hpp"
 #include "bbw/security/dds_security.hpp"
 #include "fault_report.hpp"
 #include "report.hpp"
@@ -61,7 +62,7 @@ using bbw::launch::Clock;
 const char* kUsage =
     "usage: bbw_launch SCENARIO.yaml --out DIR [--mode lockstep|realtime] [--domain N]\n"
     "                  [--discovery-timeout S] [--friction-feedback on|off] [--no-report]\n"
-    "                  [--secure [--keys DIR]]\n";
+    "                  [--secure [--keys DIR]] [--allow-large]\n";
 
 std::string last_line(const std::string& file) {
   std::ifstream f(file);
@@ -96,6 +97,7 @@ int main(int argc, char** argv) {
   double discovery_s = 20.0;
   bool report = true;
   bool secure = false;
+  bool allow_large = false;  // --allow-large: accept a run over the size limits (scenario/run_checks.hpp)
   std::string keys_dir = std::string(BBW_REPO_DIR) + "/keys";
   int domain = 0;
   try {
@@ -111,6 +113,7 @@ int main(int argc, char** argv) {
       else if (k == "--no-report") report = false;
       else if (k == "--secure") secure = true;
       else if (k == "--keys") keys_dir = next();
+      else if (k == "--allow-large") allow_large = true;
       else if (k == "-h" || k == "--help") { std::cout << kUsage; return 0; }
       else if (!k.empty() && k[0] == '-') throw std::invalid_argument("unknown argument '" + k + "'");
       else if (scenario_file.empty()) scenario_file = k;
@@ -132,6 +135,8 @@ int main(int argc, char** argv) {
     auto fs = bbw::faults::load_fault_scenario(scenario_file);
     scenario = std::move(fs.scenario);
     schedule = std::move(fs.faults);
+    bbw::scenario::check_four_corner_run(*scenario);
+    if (!allow_large) bbw::scenario::check_run_size(*scenario);
     for (const auto& a : bbw::faults::process_actions(schedule)) {
       if (a.target == bbw::faults::Target::CCU && a.kind == bbw::faults::ProcessAction::Kind::Restart) {
         throw std::invalid_argument(scenario_file + ": restarting the CCU is not supported over DDS (a kill of the CCU ends the run)");

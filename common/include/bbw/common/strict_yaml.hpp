@@ -34,6 +34,21 @@ class ConfigError : public std::runtime_error {
   std::string rule_;
 };
 
+// Bounds on what a parsed document may expand to, checked before any loader reads it. yaml-cpp
+// shares an aliased node, so parsing stays small, but every reader that walks or copies the tree
+// pays for each use of an alias: a 44 KB file with one 20 000-entry list aliased 1000 times is a
+// 20-million-node document. Nodes are counted the way a reader sees them (an alias counts its
+// whole subtree again at each use). docs/security.md, "Inputs", lists the values and tests.
+struct DocumentLimits {
+  std::size_t max_nodes = 200000;       // scalars, lists and mappings, aliases expanded
+  std::size_t max_list_entries = 20000; // entries of one list (or mapping)
+  std::size_t max_depth = 64;           // nesting of lists and mappings (an alias to itself is refused)
+  std::size_t max_scalar_chars = 4096;  // characters of one scalar
+};
+
+// Throws ConfigError naming the file, the line and the key path where a limit was passed.
+void check_document(const YAML::Node& root, const std::string& file, const DocumentLimits& limits = {});
+
 // Closed or open numeric interval used as a validation rule.
 struct Range {
   double lo = -std::numeric_limits<double>::infinity();
@@ -58,10 +73,12 @@ class Reader {
  public:
   Reader(YAML::Node node, std::string file, std::string path = "");
 
-  // Parses a file. Syntax errors become ConfigError with the parser's line.
-  static Reader from_file(const std::string& file);
+  // Parses a file: only a regular file of at most 4 MiB is opened (a directory, FIFO or device
+  // is refused before reading), then check_document(). Syntax errors become ConfigError with
+  // the parser's line.
+  static Reader from_file(const std::string& file, const DocumentLimits& limits = {});
   // Parses a string (tests, embedded defaults). `name` stands in for the file.
-  static Reader from_string(const std::string& text, const std::string& name);
+  static Reader from_string(const std::string& text, const std::string& name, const DocumentLimits& limits = {});
 
   bool has(const std::string& key) const;
 

@@ -43,6 +43,7 @@ struct DemandSpec {
 
 struct CornerSpec {
   std::string name;                             // free text offline; FL/FR/RL/RR over DDS
+  int line = 0;                                 // line of its entry in the file (0 if built in code)
   std::optional<Axle> axle;                     // given, or inferred from FL/FR/RL/RR
   plant::Conditions conditions;                 // temperature (and its ramp), wear
   plant::EffectsParams effects;                 // all off unless the file switches them on
@@ -55,6 +56,7 @@ struct Scenario {
   std::string file;                             // the file it was loaded from ("" if built in code)
   std::uint64_t seed = 1;
   double duration_s = 10.0;
+  int duration_line = 0;                        // line of duration_s in the file (0 if built in code)
   double plant_dt_s = 0.001;
   double ccu_period_s = 0.005;                  // used by the DDS system
   std::string plant_file;                       // resolved path of the plant parameter file

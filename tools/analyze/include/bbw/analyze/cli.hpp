@@ -14,6 +14,7 @@ struct CliArgs {
   std::string time_col, position_col, force_col, truth_col, temperature_col, velocity_col, acceleration_col;
   bool channels_given = false;
   std::vector<std::string> channels;  // "--channels none" gives an empty list
+  bool allow_unsorted_time = false;   // drop (and count) lines whose time does not increase
 };
 
 std::string usage();
@@ -26,7 +27,7 @@ struct LoadedRecording {
   std::string time_col, position_col, force_col, truth_col, temperature_col, velocity_col, acceleration_col;
   std::vector<std::string> channel_cols;
   std::string force_unit, position_unit;
-  std::size_t lines_read = 0, lines_rejected = 0;
+  std::size_t lines_read = 0, lines_rejected = 0, lines_unsorted_time = 0;
   std::string rejection_summary;
 };
 
@@ -34,7 +35,9 @@ struct LoadedRecording {
 std::string unit_from_column(const std::string& column);
 
 // Reads the CSV: required time/position/force, optional truth/temperature/velocity/acceleration;
-// channels default to every other column of the header. Throws on a missing column.
+// channels default to every other column of the header. Throws csv::CsvError for a file the
+// reader refuses (not a regular file, duplicate column, time not increasing, ...) and
+// std::invalid_argument for a named column the header lacks.
 LoadedRecording load_recording(const CliArgs& a);
 
 }  // namespace bbw::analyze
