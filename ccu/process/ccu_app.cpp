@@ -35,7 +35,7 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
     : scenario_(scenario),
       options_(options),
       events_(events),
-      node_(scenario, calibrator, options.friction_feedback),
+      node_(scenario, calibrator, options.friction_feedback, options.monitor),
       periods_(node_.periods()),
       participant_(named(options.participant)),
       commands_(participant_, dds::kCommandTopic,

@@ -45,6 +45,7 @@ using dds::kExitUsage;
 struct CcuOptions : dds::ProcessOptions {
   std::string out_dir;                            // per-corner CSVs and ccu.stats; "" for none
   bool friction_feedback = true;                  // let corners use compensated feedback
+  faults::MonitorParams monitor;                  // config/faults/monitor.yaml (--monitor)
   faults::FaultSchedule schedule;
 };
 

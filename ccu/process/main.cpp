@@ -4,7 +4,7 @@
 //   bbw_ccu --scenario FILE [--domain N] [--mode lockstep|realtime]
 //           [--discovery-timeout S] [--peer-timeout S] [--process-faults]
 //           [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--secure KEYS_DIR]
-//           [--out DIR] [--calibrator FILE.yaml] [--friction-feedback on|off]
+//           [--out DIR] [--calibrator FILE.yaml] [--monitor FILE.yaml] [--friction-feedback on|off]
 //
 // The flags in the first three lines are bbw_corner's too (bbw/dds/process_cli.hpp).
 //
@@ -26,6 +26,7 @@
 
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/dds/process_cli.hpp"
+#include "bbw/faults/monitor_yaml.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/launch/signals.hpp"
 #include "bbw/scenario/load.hpp"
@@ -35,7 +36,7 @@
 namespace {
 
 std::string usage() {
-  return bbw::dds::process_usage("bbw_ccu", "", {"[--out DIR] [--calibrator FILE.yaml] [--friction-feedback on|off]"});
+  return bbw::dds::process_usage("bbw_ccu", "", {"[--out DIR] [--calibrator FILE.yaml] [--monitor FILE.yaml] [--friction-feedback on|off]"});
 }
 
 }  // namespace
@@ -48,12 +49,14 @@ int main(int argc, char** argv) {
   CcuOptions opt;
   bbw::dds::ProcessFlags flags;
   std::string calibrator_file = BBW_DEFAULT_CALIBRATOR_CONFIG;
+  std::string monitor_file = BBW_DEFAULT_MONITOR_CONFIG;
   try {
     for (bbw::dds::ArgCursor args(argc, argv); !args.done();) {
       const std::string k = args.flag();
       if (flags.take(k, args)) continue;
       if (k == "--out") opt.out_dir = args.value();
       else if (k == "--calibrator") calibrator_file = args.value();
+      else if (k == "--monitor") monitor_file = args.value();
       else if (k == "--friction-feedback") {
         const std::string v = args.value();
         if (v != "on" && v != "off") throw std::invalid_argument("--friction-feedback must be on or off, got '" + v + "'");
@@ -84,6 +87,7 @@ int main(int argc, char** argv) {
     opt.schedule = std::move(fs.faults);
     calibrator = bbw::calibration::load_config(calibrator_file);
     calibrator->validate();
+    opt.monitor = bbw::faults::load_monitor_params(monitor_file);
     if (!opt.out_dir.empty()) {
       ::mkdir(opt.out_dir.c_str(), 0755);
       struct stat st {};

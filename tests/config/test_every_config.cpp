@@ -9,6 +9,7 @@
 
 #include "bbw/analyze/config_loader.hpp"
 #include "bbw/calibration/config_yaml.hpp"
+#include "bbw/faults/monitor_yaml.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/plant/params_yaml.hpp"
 #include "bbw/scenario/load.hpp"
@@ -25,6 +26,7 @@ TEST(EveryConfig, EachYamlFileLoadsWithItsFoldersLoader) {
       {"scenarios/faults", [](const std::string& f) { bbw::faults::load_fault_scenario(f); }},
       {"calibrator", [](const std::string& f) { bbw::calibration::load_config(f); }},
       {"analysis", [](const std::string& f) { bbw::analyze::load_options_file(f); }},
+      {"faults", [](const std::string& f) { bbw::faults::load_monitor_params(f); }},
   };
   int loaded = 0;
   for (const auto& entry : fs::recursive_directory_iterator(root)) {

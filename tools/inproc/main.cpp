@@ -1,4 +1,4 @@
-// bbw_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--friction-feedback on|off]
+// bbw_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--monitor FILE] [--friction-feedback on|off]
 // The CCU node and one corner node per scenario corner over the in-memory transport, in one
 // process and one thread, in lockstep: the same node cores and protocol as `./bbw run` over
 // Fast DDS, so it writes the same logs (ccu_<corner>.csv, ccu_periods.csv,
@@ -15,6 +15,7 @@
 #include <string>
 
 #include "bbw/calibration/config_yaml.hpp"
+#include "bbw/faults/monitor_yaml.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/node/csv_log.hpp"
 #include "bbw/node/in_process.hpp"
@@ -23,7 +24,7 @@ namespace {
 
 int usage(const std::string& why) {
   std::cerr << "bbw_inproc: " << why << "\n"
-            << "usage: bbw_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--friction-feedback on|off]\n";
+            << "usage: bbw_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--monitor FILE] [--friction-feedback on|off]\n";
   return 2;
 }
 
@@ -31,6 +32,7 @@ int usage(const std::string& why) {
 
 int main(int argc, char** argv) {
   std::string scenario_file, out_dir, calibrator_file = BBW_DEFAULT_CALIBRATOR_CONFIG;
+  std::string monitor_file = BBW_DEFAULT_MONITOR_CONFIG;
   bbw::node::InProcessOptions options;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -41,12 +43,13 @@ int main(int argc, char** argv) {
     try {
       if (a == "--out") out_dir = value("--out");
       else if (a == "--calibrator") calibrator_file = value("--calibrator");
+      else if (a == "--monitor") monitor_file = value("--monitor");
       else if (a == "--friction-feedback") {
         const std::string v = value("--friction-feedback");
         if (v != "on" && v != "off") return usage("--friction-feedback must be on or off, got '" + v + "'");
         options.friction_feedback = v == "on";
       } else if (a == "-h" || a == "--help") {
-        std::cout << "usage: bbw_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--friction-feedback on|off]\n";
+        std::cout << "usage: bbw_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--monitor FILE] [--friction-feedback on|off]\n";
         return 0;
       } else if (!a.empty() && a[0] == '-') return usage("unknown argument '" + a + "'");
       else if (scenario_file.empty()) scenario_file = a;
@@ -63,6 +66,7 @@ int main(int argc, char** argv) {
     options.schedule = fs.faults;
     auto calibrator = bbw::calibration::load_config(calibrator_file);
     calibrator.validate();
+    options.monitor = bbw::faults::load_monitor_params(monitor_file);
     std::error_code ec;
     std::filesystem::create_directories(out_dir, ec);
     if (ec || !std::filesystem::is_directory(out_dir)) {

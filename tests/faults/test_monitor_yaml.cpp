@@ -1,0 +1,80 @@
+// config/faults/monitor.yaml: the shipped file is the monitor's defaults, every field; bad files
+// are refused with file, line, key and rule.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "bbw/faults/monitor_yaml.hpp"
+#include "closed_loop.hpp"
+
+namespace bbw::faults {
+
+namespace {
+
+std::string shipped_text() {
+  std::FILE* f = std::fopen(test::source_path("config/faults/monitor.yaml").c_str(), "r");
+  std::string s;
+  char buf[4096];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) s.append(buf, n);
+  std::fclose(f);
+  return s;
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    auto r = config::Reader::from_string(text, "monitor.yaml");
+    read_monitor_params(r);
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string replaced(std::string s, const std::string& from, const std::string& to) {
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return s.replace(at, from.size(), to);
+}
+
+}  // namespace
+
+TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
+  const MonitorParams y = load_monitor_params(test::source_path("config/faults/monitor.yaml"));
+  const MonitorParams d;
+#define SAME(f) EXPECT_EQ(y.f, d.f) << #f
+  SAME(guard.position_min_rev); SAME(guard.position_max_rev); SAME(guard.speed_abs_max_rev_per_s);
+  SAME(guard.load_cell_min_kN); SAME(guard.load_cell_max_kN); SAME(guard.current_abs_max_A);
+  SAME(guard.max_sequence_jump); SAME(guard.max_time_jump_s);
+  SAME(residual_threshold_kN); SAME(uncalibrated_residual_threshold_kN); SAME(residual_persist_s);
+  SAME(residual_reference_s); SAME(residual_change_threshold_kN); SAME(curve_min_rev); SAME(curve_max_rev);
+  SAME(residual_on_profile_corners); SAME(residual_findings);
+  SAME(jump_threshold_rev); SAME(jump_confirm_s); SAME(jump_window_s);
+  SAME(stuck_samples); SAME(stuck_min_travel_rev); SAME(stuck_min_force_change_kN); SAME(frozen_attribution_samples);
+  SAME(noise_window_samples); SAME(noise_step_kN); SAME(noise_min_fraction); SAME(dropout_samples);
+  SAME(torque_per_A_Nm); SAME(Nm_per_kN); SAME(inertia_kg_m2);
+  SAME(torque_filter_s); SAME(torque_check_min_load_kN); SAME(torque_check_min_torque_Nm);
+  SAME(torque_fraction_threshold); SAME(torque_check_max_speed_rev_per_s); SAME(torque_persist_s);
+  SAME(torque_lost_threshold); SAME(torque_lost_persist_s);
+  SAME(tracking_time_constant_s); SAME(tracking_threshold_kN); SAME(tracking_relative); SAME(tracking_persist_s);
+  SAME(force_limit_kN); SAME(release_min_speed_rev_per_s); SAME(deadline_s);
+#undef SAME
+}
+
+TEST(MonitorYaml, BadFilesNameFileLineKeyAndRule) {
+  const std::string ok = shipped_text();
+  EXPECT_EQ(error_of(ok), "");
+  const std::string unknown = error_of(replaced(ok, "  deadline_s: 0.015", "  deadline_s: 0.015\n  deadline_ms: 15"));
+  EXPECT_NE(unknown.find("link.deadline_ms"), std::string::npos) << unknown;
+  const std::string missing = error_of(replaced(ok, "  check_min_load_kN: 8.0\n", ""));
+  EXPECT_NE(missing.find("torque.check_min_load_kN"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("missing"), std::string::npos) << missing;
+  const std::string negative = error_of(replaced(ok, "threshold_kN: 0.6", "threshold_kN: -0.6"));
+  EXPECT_NE(negative.find("monitor.yaml:"), std::string::npos) << negative;
+  EXPECT_NE(negative.find("residual.threshold_kN"), std::string::npos) << negative;
+  EXPECT_NE(negative.find("> 0"), std::string::npos) << negative;
+  // A rule between fields (MonitorParams::validate) is refused too, naming the field.
+  const std::string cross = error_of(replaced(ok, "uncalibrated_threshold_kN: 3.0", "uncalibrated_threshold_kN: 0.3"));
+  EXPECT_NE(cross.find("uncalibrated_residual_threshold_kN"), std::string::npos) << cross;
+}
+
+}  // namespace bbw::faults
