@@ -25,6 +25,7 @@
 #include <string>
 
 #include "bbw/calibration/config_yaml.hpp"
+#include "bbw/common/data_path.hpp"
 #include "bbw/dds/process_cli.hpp"
 #include "bbw/faults/monitor_yaml.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
@@ -48,8 +49,8 @@ int main(int argc, char** argv) {
 
   CcuOptions opt;
   bbw::dds::ProcessFlags flags;
-  std::string calibrator_file = BBW_DEFAULT_CALIBRATOR_CONFIG;
-  std::string monitor_file = BBW_DEFAULT_MONITOR_CONFIG;
+  std::string calibrator_file;  // default: config/calibrator/robust.yaml of bbw's data (bbw/common/data_path.hpp)
+  std::string monitor_file;     // default: config/faults/monitor.yaml
   try {
     for (bbw::dds::ArgCursor args(argc, argv); !args.done();) {
       const std::string k = args.flag();
@@ -85,6 +86,8 @@ int main(int argc, char** argv) {
     auto fs = bbw::faults::load_fault_scenario(scenario_file);
     scenario = std::move(fs.scenario);
     opt.schedule = std::move(fs.faults);
+    if (calibrator_file.empty()) calibrator_file = bbw::data::path("config/calibrator/robust.yaml");
+    if (monitor_file.empty()) monitor_file = bbw::data::path("config/faults/monitor.yaml");
     calibrator = bbw::calibration::load_config(calibrator_file);
     calibrator->validate();
     opt.monitor = bbw::faults::load_monitor_params(monitor_file);

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "bbw/calibration/config_yaml.hpp"
+#include "bbw/common/data_path.hpp"
 #include "bbw/faults/monitor_yaml.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/node/csv_log.hpp"
@@ -31,8 +32,7 @@ int usage(const std::string& why) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scenario_file, out_dir, calibrator_file = BBW_DEFAULT_CALIBRATOR_CONFIG;
-  std::string monitor_file = BBW_DEFAULT_MONITOR_CONFIG;
+  std::string scenario_file, out_dir, calibrator_file, monitor_file;  // defaults from bbw's data (data_path.hpp)
   bbw::node::InProcessOptions options;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -64,6 +64,8 @@ int main(int argc, char** argv) {
   try {
     auto fs = bbw::faults::load_fault_scenario(scenario_file);
     options.schedule = fs.faults;
+    if (calibrator_file.empty()) calibrator_file = bbw::data::path("config/calibrator/robust.yaml");
+    if (monitor_file.empty()) monitor_file = bbw::data::path("config/faults/monitor.yaml");
     auto calibrator = bbw::calibration::load_config(calibrator_file);
     calibrator.validate();
     options.monitor = bbw::faults::load_monitor_params(monitor_file);
