@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "bbw/dds/convert.hpp"
+#include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/faults/link_faults.hpp"
 #include "bbw/launch/stats_file.hpp"
@@ -79,11 +80,16 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
       periods_(static_cast<std::uint64_t>(std::ceil(scenario.duration_s / scenario.ccu_period_s - 1e-9))),
       channels_(make_channels(scenario)),
       participant_(named(options.participant)),
+      // Commands and calibration state in the run's partition, measurements and health in each
+      // corner's partition of this run (bbw/dds/run_id.hpp): another run on the domain never matches.
       commands_(participant_, dds::kCommandTopic,
-                dds::profiles_for(options.mode == ClockMode::Lockstep).command_writer, events),
-      calibration_(participant_, dds::kCalibrationTopic, "state_writer", events) {
+                dds::profiles_for(options.mode == ClockMode::Lockstep).command_writer, events,
+                dds::Partition{dds::run_partition(options.participant.run_id)}),
+      calibration_(participant_, dds::kCalibrationTopic, "state_writer", events,
+                   dds::Partition{dds::run_partition(options.participant.run_id)}) {
   for (const auto& ch : channels_) {
-    const dds::Partition partition{security::corner_partition(static_cast<int>(ch.slot))};
+    const dds::Partition partition{dds::corner_run_partition(
+        security::corner_partition(static_cast<int>(ch.slot)), options.participant.run_id)};
     blocks_.push_back(std::make_unique<BlockReader>(
         participant_, dds::kMeasurementTopic,
         dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_reader, events, partition));
@@ -138,6 +144,10 @@ void CcuApp::drain_health() {
   for (std::size_t i = 0; i < channels_.size(); ++i) {
     CornerChannel& ch = channels_[i];
     while (health_[i]->take(h)) {
+      if (h.run_id() != participant_.run_id()) {
+        ++foreign_run_samples_;  // another run's (dropped unread)
+        continue;
+      }
       if (h.corner_id() != ch.slot) {
         ++ch.foreign_health;  // another corner id in this corner's partition
         continue;
@@ -179,6 +189,7 @@ void CcuApp::send_commands(std::uint64_t step, bool stop, bool log) {
     const CornerPlan& p = plans[ch.slot];
     msg::ClampCommand c;
     c.corner_id(static_cast<std::uint8_t>(ch.slot));
+    c.run_id(participant_.run_id());
     c.seq(ch.command_seq++);
     c.step(step);
     c.time_s(t);
@@ -225,11 +236,16 @@ void CcuApp::publish_calibration(CornerChannel& ch, double time_s) {
   ++ch.calibration_version;
   msg::CalibrationState state;
   dds::to_msg(sup.calibrator(), static_cast<std::uint8_t>(ch.slot), ch.calibration_version, time_s, state);
+  state.run_id(participant_.run_id());
   calibration_.write(state);
 }
 
 void CcuApp::process_block(CornerChannel& channel_of_partition, const msg::MeasurementBlock& b,
                            const eprosima::fastdds::dds::SampleInfo& info, double arrival_s) {
+  if (b.run_id() != participant_.run_id()) {
+    ++foreign_run_samples_;  // another run's block: dropped before anything reads it
+    return;
+  }
   if (b.corner_id() != channel_of_partition.slot) {
     // Another corner id in this corner's partition: a corner posing as another (or as one
     // that does not exist). Dropped and counted before anything reads it.
@@ -541,6 +557,8 @@ void CcuApp::write_stats(const std::string& file) const {
   w.set("qos_events_dropped", static_cast<unsigned long long>(dropped));
   w.set("foreign_corner_samples", static_cast<unsigned long long>(foreign));
   w.set("unknown_corner_blocks", static_cast<unsigned long long>(unknown_corner_blocks_));
+  w.set("foreign_run_samples", static_cast<unsigned long long>(foreign_run_samples_));
+  w.set("foreign_runs", dds::join_peer_tags(participant_.foreign_runs()));
   w.set("command_write_failures", static_cast<unsigned long long>(commands_.write_failures()));
   std::string corners;
   for (const auto& ch : channels_) corners += (corners.empty() ? "" : ",") + std::string(dds::corner_name(ch.corner));

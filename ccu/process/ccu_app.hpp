@@ -143,6 +143,7 @@ class CcuApp {
   std::vector<DetectionRecord> detections_;
   std::FILE* periods_csv_ = nullptr;
   std::uint64_t unknown_corner_blocks_ = 0;
+  std::uint64_t foreign_run_samples_ = 0;  // blocks and health of another run (run id), dropped
   std::chrono::steady_clock::time_point t0_{};
   double wall_s_ = 0.0;
   double sim_s_ = 0.0;

@@ -5,10 +5,13 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
 #include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/launch/stats_file.hpp"
 
@@ -47,6 +50,20 @@ dds::ParticipantOptions named(dds::ParticipantOptions p, dds::Corner c) {
   return p;
 }
 
+std::string own_partition(const CornerOptions& o) {
+  return dds::corner_run_partition(security::corner_partition(static_cast<int>(dds::corner_index(o.corner))),
+                                   o.participant.run_id);
+}
+
+// The caliper's rated clamp force: the scenario's max_clamp_force_kN (its demand scale), else
+// the gate's default; the rate allows the full range in one CCU period.
+corner::CommandGateParams gate_params(const scenario::Scenario& s) {
+  corner::CommandGateParams p;
+  if (s.demand) p.max_force_kN = s.demand->max_clamp_force_kN;
+  p.max_rate_kN_per_s = p.max_force_kN / s.ccu_period_s;
+  return p;
+}
+
 faults::Target target_of(dds::Corner c) { return static_cast<faults::Target>(dds::corner_index(c)); }
 
 }  // namespace
@@ -61,18 +78,21 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       participant_(named(options.participant, options.corner)),
       // Measurements and health in the corner's own partition (corner_FL, ...), secure or not:
       // the permissions grant a corner only that one (docs/security.md).
+      // ... of this run (bbw/dds/run_id.hpp: corner_FL.run_<id>); commands and calibration in run_<id>.
       blocks_(participant_, dds::kMeasurementTopic,
               dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_writer, events,
-              dds::Partition{security::corner_partition(static_cast<int>(dds::corner_index(options.corner)))}),
-      health_(participant_, dds::kHealthTopic, "state_writer", events,
-              dds::Partition{security::corner_partition(static_cast<int>(dds::corner_index(options.corner)))}),
+              dds::Partition{own_partition(options)}),
+      health_(participant_, dds::kHealthTopic, "state_writer", events, dds::Partition{own_partition(options)}),
       // No DDS content filter on these topics: Fast DDS 2.9 evaluates DDS-SQL filters on the
       // writer by deserialising into DynamicData, which throws and catches internally on every
       // sample and made the CCU's command writes its largest cost. Corners drop the other
       // corners' samples here instead (4 commands per period, a few bytes each).
       commands_(participant_, dds::kCommandTopic,
-                dds::profiles_for(options.mode == ClockMode::Lockstep).command_reader, events),
-      calibration_(participant_, dds::kCalibrationTopic, "state_reader", events),
+                dds::profiles_for(options.mode == ClockMode::Lockstep).command_reader, events,
+                dds::Partition{dds::run_partition(options.participant.run_id)}),
+      calibration_(participant_, dds::kCalibrationTopic, "state_reader", events,
+                   dds::Partition{dds::run_partition(options.participant.run_id)}),
+      gate_(options.participant.run_id, gate_params(scenario)),
       my_id_(static_cast<std::uint8_t>(dds::corner_index(options.corner))),
       injector_(options.schedule, target_of(options.corner),
                 scenario::corner_seed(scenario.seed + 7777, options.scenario_index)),
@@ -80,6 +100,7 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       watchdog_(options.watchdog),
       resume_step_(static_cast<std::uint64_t>(std::ceil(options.resume_at_s / scenario.ccu_period_s - 1e-9))) {
   block_.corner_id(my_id_);
+  block_.run_id(options.participant.run_id);
   block_.incarnation(options.incarnation);
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
   if (!options.periods_log.empty()) {
@@ -97,6 +118,7 @@ CornerApp::~CornerApp() {
 void CornerApp::publish_health(std::uint8_t status) {
   msg::CornerHealth h;
   h.corner_id(my_id_);
+  h.run_id(participant_.run_id());
   h.status(status);
   h.samples_published(stats_.samples_published);
   h.blocks_published(stats_.blocks_published);
@@ -139,8 +161,20 @@ bool CornerApp::ccu_gone() const {
 // Takes every waiting command and calibration state; keeps the newest command.
 void CornerApp::drain_inputs() {
   msg::ClampCommand cmd;
-  while (commands_.take(cmd)) {
+  eprosima::fastdds::dds::SampleInfo info;
+  while (commands_.take(cmd, info)) {
     if (cmd.corner_id() != my_id_) continue;
+    // The command gate (issue 17): this run's, from the CCU of the first command, force within
+    // the caliper's range and rate; a refused command is counted and never read further.
+    corner::CommandSource source{cmd.run_id(), {}, false};
+    std::array<std::uint8_t, 12> prefix{};
+    for (std::size_t i = 0; i < source.writer.size(); ++i) source.writer[i] = info.publication_handle.value[i];
+    std::copy_n(source.writer.begin(), prefix.size(), prefix.begin());
+    const auto tag = participant_.peer_tag(prefix);
+    source.announced_as_ccu = tag && tag->run_id == participant_.run_id() && tag->name == "bbw_ccu";
+    const corner::GateResult gated = gate_.check(source, cmd.mode() == msg::MODE_FORCE, cmd.clamp_force_kN(), cmd.time_s());
+    if (!gated.applies()) continue;
+    if (cmd.mode() == msg::MODE_FORCE) cmd.clamp_force_kN(gated.force_kN);
     ++stats_.commands_received;
     if (last_command_seq_ && cmd.seq() != *last_command_seq_ + 1) {
       stats_.command_seq_gaps += cmd.seq() > *last_command_seq_ ? cmd.seq() - *last_command_seq_ - 1 : 1;
@@ -161,6 +195,10 @@ void CornerApp::drain_inputs() {
   msg::CalibrationState state;
   while (calibration_.take(state)) {
     if (state.corner_id() != my_id_) continue;
+    if (state.run_id() != participant_.run_id()) {
+      ++stats_.calibrations_rejected;  // another run's
+      continue;
+    }
     if (state.version() < model_.version && friction_.started()) continue;  // stale
     dds::CalibrationModel m;
     if (!dds::from_msg(state, m)) {
@@ -379,6 +417,13 @@ void CornerApp::write_stats(const std::string& file) const {
   w.set("ccu_lost_s", s.ccu_lost_s);
   w.set("default_force_s", s.default_force_s);
   w.set("wall_s", s.wall_s);
+  const corner::CommandGateCounts& g = gate_.counts();
+  w.set("commands_clamped", static_cast<unsigned long long>(g.clamped));
+  w.set("commands_refused_run", static_cast<unsigned long long>(g.refused_run));
+  w.set("commands_refused_source", static_cast<unsigned long long>(g.refused_source));
+  w.set("commands_refused_value", static_cast<unsigned long long>(g.refused_value));
+  w.set("gate_max_force_kN", gate_.params().max_force_kN);
+  w.set("foreign_runs", dds::join_peer_tags(participant_.foreign_runs()));
   w.save(file);
 }
 

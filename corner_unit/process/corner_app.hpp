@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bbw/corner/command_gate.hpp"
 #include "bbw/dds/process_cli.hpp"
 #include "bbw/dds/convert.hpp"
 #include "bbw/dds/corner.hpp"
@@ -123,6 +124,7 @@ class CornerApp {
   dds::Writer<msg::CornerHealthPubSubType> health_;
   dds::Reader<msg::ClampCommandPubSubType> commands_;
   dds::Reader<msg::CalibrationStatePubSubType> calibration_;
+  corner::CommandGate gate_;  // every received command passes here (drain_inputs)
   std::uint8_t my_id_;
 
   faults::FaultInjector injector_;
