@@ -4,6 +4,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -105,12 +106,20 @@ ShmCleanupReport cleanup_stale_shm(const std::string& dir, std::chrono::seconds 
   }
   if (!orphans.empty()) {
     const auto mapped = mapped_files(dir);
+    // Segments first: a semaphore is mapped only while its port is being opened, so it goes
+    // only with a segment that goes too (or that no longer exists).
+    std::set<std::string> kept_segments;
+    std::stable_partition(orphans.begin(), orphans.end(), [](const std::string& n) { return n.rfind("sem.", 0) != 0; });
     for (const auto& name : orphans) {
+      const bool semaphore = name.rfind("sem.", 0) == 0;
+      const std::string segment = semaphore ? name.substr(4, name.size() - 4 - 6) : name;
       const std::string path = (fs::path(dir).lexically_normal() / name).string();
-      if (mapped.count(path) > 0) {
+      if (mapped.count(path) > 0 || (semaphore && kept_segments.count(segment) > 0)) {
         ++report.kept_live;
+        if (!semaphore) kept_segments.insert(segment);
       } else if (!older_than(root / name, min_age)) {
         ++report.kept_young;
+        if (!semaphore) kept_segments.insert(segment);
       } else if (fs::remove(root / name, ec)) {
         report.removed.push_back(name);
       }

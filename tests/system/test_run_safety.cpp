@@ -306,7 +306,7 @@ TEST(SystemStops, AKilledCcuStillYieldsASummaryAndTheNextLaunchRemovesItsSharedM
   };
   const auto stale = domain_files();
   ASSERT_FALSE(stale.empty()) << "the killed run left no port file: nothing to clean";
-  // The cleanup keeps files younger than 2 s (a process may be creating them right now); these
+  // The cleanup keeps files younger than 5 s (a process may be creating them right now); these
   // are a dead run's, so they are dated back rather than waited for.
   for (const auto& f : stale) {
     std::error_code ec;

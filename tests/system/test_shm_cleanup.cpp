@@ -90,6 +90,7 @@ TEST_F(ShmDir, RemovesOrphanPortFilesNobodyMapsAndKeepsMappedOnes) {
   touch("sem.fastrtps_port7511_mutex", true);
   touch("fastrtps_port7513", false);  // young
   touch("fastrtps_port7515", true);   // mapped by this process: live
+  touch("sem.fastrtps_port7515_mutex", true);  // not mapped, but its port is live: kept
   const int fd = ::open((dir_ / "fastrtps_port7515").c_str(), O_RDONLY);
   ASSERT_GE(fd, 0);
   void* map = ::mmap(nullptr, 1, PROT_READ, MAP_SHARED, fd, 0);
@@ -101,9 +102,10 @@ TEST_F(ShmDir, RemovesOrphanPortFilesNobodyMapsAndKeepsMappedOnes) {
   EXPECT_FALSE(exists("sem.fastrtps_port7511_mutex"));
   EXPECT_TRUE(exists("fastrtps_port7513"));
   EXPECT_TRUE(exists("fastrtps_port7515"));
+  EXPECT_TRUE(exists("sem.fastrtps_port7515_mutex"));
   EXPECT_EQ(report.removed.size(), 2u);
   EXPECT_EQ(report.kept_young, 1u);
-  EXPECT_EQ(report.kept_live, 1u);
+  EXPECT_EQ(report.kept_live, 2u);
   ::munmap(map, 1);
   ::close(fd);
 }

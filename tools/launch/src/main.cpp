@@ -12,7 +12,16 @@
 // output in DIR/<name>.out/.err, waits for them to finish within a bounded wall time, and
 // writes DIR/summary.json and DIR/report.html. If a process dies or fails (discovery timeout,
 // lost peer), the others are stopped and the launcher exits non-zero naming the process and
-// the reason. Exit: 0 ok, 1 a process failed or the run exceeded its bound, 2 bad arguments.
+// the reason, after a partial summary from what the processes logged (partial_summary.hpp).
+// SIGINT/SIGTERM stop the run the same way, with a partial summary marked interrupted.
+// Exit: 0 ok, 1 a process failed or the run exceeded its bound, 2 bad arguments, 130/143
+// stopped by SIGINT/SIGTERM.
+//
+// Each run draws a random run id (/dev/urandom) that every child gets as --run-id: its DDS
+// partitions and messages carry it, so runs on one domain never mix (docs/distributed.md,
+// "Runs on one host"). Without --domain and BBW_DOMAIN a free domain is chosen
+// (domain_claim.hpp). DIR is created, or cleared of an older run's files, or refused when it
+// holds files bbw did not write (out_dir.hpp).
 //
 // Process faults of the scenario's schedule (docs/faults.md) are carried out here: a process
 // freezes itself (SIGSTOP) at its scheduled kill time (lockstep: the period; realtime: its wall

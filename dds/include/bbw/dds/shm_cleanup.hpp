@@ -26,6 +26,6 @@ struct ShmCleanupReport {
 };
 
 ShmCleanupReport cleanup_stale_shm(const std::string& dir = "/dev/shm",
-                                   std::chrono::seconds min_age = std::chrono::seconds(2));
+                                   std::chrono::seconds min_age = std::chrono::seconds(5));
 
 }  // namespace bbw::dds
