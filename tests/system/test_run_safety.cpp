@@ -193,9 +193,9 @@ TEST(SystemIsolation, TwoSecureRunsOnOneDomainEachEqualTheSoloRun) {
     const auto st = solo.wait(150s);
     ASSERT_TRUE(st.ok()) << describe(st, solo);
   }
-  // The keys first (bbw_launch would make them; two launchers must not make them at once).
-  const ProcessRun keys = run("keys", {src("scripts/bbw-keys.sh"), dir + "/keys"}, dir, 120s);
-  ASSERT_TRUE(keys.status.ok()) << keys.out << keys.err;
+  // No keys yet: both launchers find them missing at once; one creates them while the other
+  // waits on the keys directory's lock.
+  ASSERT_FALSE(fs::exists(dir + "/keys"));
   const std::vector<std::string> secure{"--secure", "--keys", dir + "/keys"};
   Launch a(dir, "a", launch_argv(scenario, dir + "/a", "lockstep", 202, secure), env);
   Launch b(dir, "b", launch_argv(scenario, dir + "/b", "lockstep", 202, secure), env);
@@ -203,6 +203,10 @@ TEST(SystemIsolation, TwoSecureRunsOnOneDomainEachEqualTheSoloRun) {
   const auto sb = b.wait(200s);
   ASSERT_TRUE(sa.ok()) << describe(sa, a);
   ASSERT_TRUE(sb.ok()) << describe(sb, b);
+  EXPECT_NE((a.out() + b.out()).find("creating DDS Security keys"), std::string::npos);
+  EXPECT_TRUE(a.out().find("creating DDS Security keys") == std::string::npos ||
+              b.out().find("creating DDS Security keys") == std::string::npos)
+      << "both launchers created the keys";
   expect_same_logs(dir + "/solo", dir + "/a", "secure run a");
   expect_same_logs(dir + "/solo", dir + "/b", "secure run b");
   for (const char* run_dir : {"/a", "/b"}) {

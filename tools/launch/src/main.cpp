@@ -30,8 +30,11 @@
 // realtime: restart_after_s of wall time later). A scheduled kill is not a failure: after a CCU
 // kill the corners run to the end in their safe state and the run is reported as ended by the
 // injected fault. Any other death is an error naming the process.
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -187,6 +190,18 @@ int main(int argc, char** argv) {
     // Keys: created by scripts/bbw-keys.sh when any file is missing (idempotent), then checked.
     std::error_code ec;
     keys_dir = std::filesystem::absolute(keys_dir, ec).lexically_normal().string();
+    // One launcher at a time checks and creates the keys of a directory (two runs started at
+    // once must not both write it): an flock on a lock file named after it, held until here ends.
+    const std::string keys_lock = "/tmp/bbw-keys-" + std::to_string(std::hash<std::string>{}(keys_dir)) + ".lock";
+    const int keys_lock_fd = ::open(keys_lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (keys_lock_fd < 0 || ::flock(keys_lock_fd, LOCK_EX) != 0) {
+      std::cerr << "bbw_launch: cannot lock " << keys_lock << " for the keys in " << keys_dir << "\n";
+      return 1;
+    }
+    struct CloseLock {
+      int fd;
+      ~CloseLock() { ::close(fd); }
+    } close_keys_lock{keys_lock_fd};
     auto check_keys = [&]() -> std::string {
       try {
         for (const auto& id : bbw::security::identities()) bbw::security::files_for(keys_dir, id);
