@@ -55,11 +55,11 @@ std::string own_partition(const CornerOptions& o) {
                                    o.participant.run_id);
 }
 
-// The caliper's rated clamp force: the scenario's max_clamp_force_kN (its demand scale), else
-// the gate's default; the rate allows the full range in one CCU period.
+// The caliper's rated clamp force from the plant config; the rate allows the full range in one
+// CCU period.
 corner::CommandGateParams gate_params(const scenario::Scenario& s) {
   corner::CommandGateParams p;
-  if (s.demand) p.max_force_kN = s.demand->max_clamp_force_kN;
+  p.max_force_kN = s.plant.rated_clamp_force_kN;
   p.max_rate_kN_per_s = p.max_force_kN / s.ccu_period_s;
   return p;
 }
