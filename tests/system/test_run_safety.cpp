@@ -21,7 +21,6 @@
 #include <vector>
 
 #include "bbw/launch/child.hpp"
-#include "bbw/launch/stats_file.hpp"
 #include "system_test_support.hpp"
 
 namespace {
@@ -140,10 +139,6 @@ void expect_same_logs(const std::string& solo, const std::string& other, const s
     EXPECT_TRUE(a == b) << what << ": " << f << " differs from the solo run's (" << a.size() << " vs " << b.size()
                         << " bytes)";
   }
-}
-
-double stat(const std::string& file, const std::string& key) {
-  return bbw::launch::stat_number(bbw::launch::read_stats(file), key, file);
 }
 
 // Domain 200 (solo) and 201 (two runs at once): two lockstep runs of one scenario started
