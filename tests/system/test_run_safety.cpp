@@ -53,7 +53,8 @@ std::map<std::string, pid_t> children_of(pid_t pid) {
   while (f >> c) {
     std::string comm = slurp("/proc/" + std::to_string(c) + "/comm");
     while (!comm.empty() && comm.back() == '\n') comm.pop_back();
-    out[comm + (out.count(comm) ? "#" + std::to_string(c) : "")] = c;
+    if (out.count(comm) > 0) comm += '#' + std::to_string(c);  // a second process of that name
+    out[comm] = c;
   }
   return out;
 }
