@@ -76,9 +76,9 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       steps_per_period_(steps_per_period(scenario)),
       periods_(static_cast<std::uint64_t>(std::ceil(scenario.duration_s / scenario.ccu_period_s - 1e-9))),
       participant_(named(options.participant, options.corner)),
-      // Measurements and health in the corner's own partition (corner_FL, ...), secure or not:
-      // the permissions grant a corner only that one (docs/security.md).
-      // ... of this run (bbw/dds/run_id.hpp: corner_FL.run_<id>); commands and calibration in run_<id>.
+      // Measurements and health in the corner's own partition of this run (corner_FL.run_<id>,
+      // bbw/dds/run_id.hpp), secure or not: the permissions grant a corner only its own
+      // (docs/security.md). Commands and calibration state in the run's partition run_<id>.
       blocks_(participant_, dds::kMeasurementTopic,
               dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_writer, events,
               dds::Partition{own_partition(options)}),
@@ -164,14 +164,17 @@ void CornerApp::drain_inputs() {
   eprosima::fastdds::dds::SampleInfo info;
   while (commands_.take(cmd, info)) {
     if (cmd.corner_id() != my_id_) continue;
-    // The command gate (issue 17): this run's, from the CCU of the first command, force within
-    // the caliper's range and rate; a refused command is counted and never read further.
+    // The command gate (issue 17): this run's, from the CCU matched at start (the first writer
+    // whose participant announced itself as this run's bbw_ccu), force within the caliper's
+    // rated range and rate; a refused command is counted and never read further.
     corner::CommandSource source{cmd.run_id(), {}, false};
-    std::array<std::uint8_t, 12> prefix{};
     for (std::size_t i = 0; i < source.writer.size(); ++i) source.writer[i] = info.publication_handle.value[i];
-    std::copy_n(source.writer.begin(), prefix.size(), prefix.begin());
-    const auto tag = participant_.peer_tag(prefix);
-    source.announced_as_ccu = tag && tag->run_id == participant_.run_id() && tag->name == "bbw_ccu";
+    if (!gate_.pinned()) {  // the announcement matters only until the CCU's writer is pinned
+      std::array<std::uint8_t, 12> prefix{};
+      std::copy_n(source.writer.begin(), prefix.size(), prefix.begin());
+      const auto tag = participant_.peer_tag(prefix);
+      source.announced_as_ccu = tag && tag->run_id == participant_.run_id() && tag->name == "bbw_ccu";
+    }
     const corner::GateResult gated = gate_.check(source, cmd.mode() == msg::MODE_FORCE, cmd.clamp_force_kN(), cmd.time_s());
     if (!gated.applies()) continue;
     if (cmd.mode() == msg::MODE_FORCE) cmd.clamp_force_kN(gated.force_kN);
