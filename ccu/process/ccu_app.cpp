@@ -242,10 +242,6 @@ void CcuApp::publish_calibration(CornerChannel& ch, double time_s) {
 
 void CcuApp::process_block(CornerChannel& channel_of_partition, const msg::MeasurementBlock& b,
                            const eprosima::fastdds::dds::SampleInfo& info, double arrival_s) {
-  if (b.run_id() != participant_.run_id()) {
-    ++foreign_run_samples_;  // another run's block: dropped before anything reads it
-    return;
-  }
   if (b.corner_id() != channel_of_partition.slot) {
     // Another corner id in this corner's partition: a corner posing as another (or as one
     // that does not exist). Dropped and counted before anything reads it.
@@ -331,6 +327,10 @@ void CcuApp::drain_blocks(double arrival_s) {
   for (std::size_t i = 0; i < channels_.size(); ++i) {
     CornerChannel& ch = channels_[i];
     while (blocks_[i]->take(block_, info)) {
+      if (block_.run_id() != participant_.run_id()) {
+        ++foreign_run_samples_;  // another run's block: dropped before anything reads it or its rate
+        continue;
+      }
       if (ch.block_tokens < 1.0) {
         ++ch.blocks_over_rate;  // beyond the corner's rate: dropped unread
         continue;

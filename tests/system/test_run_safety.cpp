@@ -381,7 +381,9 @@ TEST(SystemStops, AReusedOutputDirectoryIsClearedOrRefused) {
 // anyone on the domain can read it in discovery) commands 77.7 kN on every corner of a
 // realtime run for its whole length. Its commands reach the corners (matched), and every
 // corner refuses them: it takes commands only from the CCU it matched at start. No period
-// applies more than the caliper's 40 kN.
+// applies more than the caliper's 40 kN. Commands and measurement blocks stamped with another
+// run's id inside this run's partitions are dropped and counted (corners: commands_refused_run;
+// CCU: run.foreign_run_samples).
 TEST(SystemGate, CornersRefuseAnIntrudersCommandsThatReachThem) {
   const std::string dir = scratch("gate");
   Launch l(dir, "bbw_launch", launch_argv("tests/system/data/short_stop.yaml", dir + "/out", "realtime", 210));
@@ -389,11 +391,22 @@ TEST(SystemGate, CornersRefuseAnIntrudersCommandsThatReachThem) {
   ASSERT_EQ(run_id.size(), 16u) << l.out() << l.err();
   Launch intruder(dir, "intruder", {bin("bbw_intruder"), "--as", "none", "--domain", "210", "--run-id", run_id,
                                     "--duration-s", "60", "--force-kN", "77.7"});
+  // Two more in the run's partitions with another run's id stamped on their messages: commands
+  // to the corners and measurement blocks as FL to the CCU. Both are dropped and counted.
+  std::string other_id = run_id;
+  other_id.back() = other_id.back() == '0' ? '1' : '0';
+  Launch stamped(dir, "stamped", {bin("bbw_intruder"), "--as", "none", "--domain", "210", "--run-id", run_id,
+                                  "--stamp-run-id", other_id, "--duration-s", "60", "--force-kN", "77.7"});
+  Launch blocks(dir, "blocks", {bin("bbw_intruder"), "--as", "none", "--corner", "FL", "--measurements", "flood",
+                                "--rate-x", "1", "--domain", "210", "--run-id", run_id, "--stamp-run-id", other_id,
+                                "--duration-s", "60"});
   const auto st = l.wait(150s);
   ASSERT_TRUE(st.ok()) << describe(st, l);
-  intruder.signal(SIGTERM);
-  const auto ist = intruder.wait(20s);
-  EXPECT_TRUE(ist.ok()) << describe(ist, intruder);
+  for (Launch* p : {&intruder, &stamped, &blocks}) {
+    p->signal(SIGTERM);
+    const auto ist = p->wait(20s);
+    EXPECT_TRUE(ist.ok()) << describe(ist, *p);
+  }
   const std::string ij = intruder.out();
   const auto mm = ij.find("\"max_matched\":");
   ASSERT_NE(mm, std::string::npos) << ij;
@@ -405,6 +418,10 @@ TEST(SystemGate, CornersRefuseAnIntrudersCommandsThatReachThem) {
     EXPECT_EQ(c.at("commands_clamped"), "0") << c.at("corner") << ": the CCU's own commands were clamped";
   }
   EXPECT_GT(refused, 100.0) << "the corners refused (almost) none of the intruder's commands\n" << j;
+  double refused_run = 0.0;
+  for (const auto& c : objects(j, "corners")) refused_run += std::stod(c.at("commands_refused_run"));
+  EXPECT_GT(refused_run, 100.0) << "commands stamped with another run's id were not refused\n" << j;
+  EXPECT_GT(std::stod(field(j, "foreign_run_samples")), 100.0) << "blocks of another run were not dropped\n" << j;
   for (const char* c : kCorners) {
     std::ifstream f(dir + "/out/corner_" + c + "_periods.csv");
     std::string line;
