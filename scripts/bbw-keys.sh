@@ -17,9 +17,10 @@
 # --force regenerates everything. Keys are test material: never commit them (.gitignore /keys/).
 #
 # Topic names (dds/include/bbw/dds/topics.hpp) and the per-corner partitions are fixed here:
-#   CCU   publishes bbw/ClampCommand, bbw/CalibrationState (any partition)
+#   CCU   publishes bbw/ClampCommand, bbw/CalibrationState (any partition: run_<id>, none)
 #         subscribes bbw/MeasurementBlock, bbw/CornerHealth (partitions corner_*)
-#   <c>   publishes bbw/MeasurementBlock, bbw/CornerHealth only in partition corner_<C>
+#   <c>   publishes bbw/MeasurementBlock, bbw/CornerHealth only in partitions corner_<C> and
+#         corner_<C>.run_* (its partition in one run, issue 17)
 #         subscribes bbw/ClampCommand, bbw/CalibrationState
 set -euo pipefail
 
@@ -186,17 +187,21 @@ $3
 PERM
 }
 
-# rule publish|subscribe PARTITION TOPIC...  (PARTITION "" = no partition restriction)
+# rule publish|subscribe "PARTITION..." TOPIC...  (space-separated partition patterns; "" = only
+# the default, partition-less one)
 rule() {
-  local kind="$1" part="$2"
+  local kind="$1" parts="$2"
   shift 2
   echo "        <$kind>"
   echo "          <topics>"
-  local t
+  local t p list
   for t in "$@"; do echo "            <topic>$t</topic>"; done
   echo "          </topics>"
-  if [ -n "$part" ]; then
-    echo "          <partitions><partition>$part</partition></partitions>"
+  if [ -n "$parts" ]; then
+    read -r -a list <<< "$parts"  # no glob expansion of the patterns
+    echo -n "          <partitions>"
+    for p in "${list[@]}"; do echo -n "<partition>$p</partition>"; done
+    echo "</partitions>"
   fi
   echo "        </$kind>"
 }
@@ -221,12 +226,15 @@ sign_doc "$DIR/ca" "$DIR/governance.xml" "$DIR/governance.p7s"
 
 for id in "${IDS[@]}"; do
   if [ "$id" = ccu ]; then
-    pub="$(rule publish "" "$TOPIC_CMD" "$TOPIC_CAL")"
+    # Commands and calibration state in a run's partition run_<id> (issue 17) or none.
+    pub="$(rule publish "*" "$TOPIC_CMD" "$TOPIC_CAL")"
     sub="$(rule subscribe "corner_*" "$TOPIC_MEAS" "$TOPIC_HEALTH")"
   else
     up="$(echo "$id" | tr '[:lower:]' '[:upper:]')"
-    pub="$(rule publish "corner_$up" "$TOPIC_MEAS" "$TOPIC_HEALTH")"
-    sub="$(rule subscribe "" "$TOPIC_CMD" "$TOPIC_CAL")"
+    # corner_<C>.run_<id>: the corner's partition in one run (issue 17); corner_<C> alone is
+    # what processes started without a run used before.
+    pub="$(rule publish "corner_$up corner_$up.run_*" "$TOPIC_MEAS" "$TOPIC_HEALTH")"
+    sub="$(rule subscribe "*" "$TOPIC_CMD" "$TOPIC_CAL")"
   fi
   permissions_xml "$(rfc2253 "bbw_$id")" "$pub" "$sub" "bbw_$id" | write_if_changed "$DIR/$id/permissions.xml"
   sign_doc "$DIR/ca" "$DIR/$id/permissions.xml" "$DIR/$id/permissions.p7s"
@@ -239,7 +247,7 @@ validity_from_ca "$DIR/rogue/ca"
 new_identity "$DIR/rogue/ca" "$DIR/rogue/intruder" "bbw_ccu"
 governance_xml | write_if_changed "$DIR/rogue/governance.xml"
 sign_doc "$DIR/rogue/ca" "$DIR/rogue/governance.xml" "$DIR/rogue/governance.p7s"
-permissions_xml "$(rfc2253 bbw_ccu)" "$(rule publish "" "*")" "$(rule subscribe "" "*")" "intruder" |
+permissions_xml "$(rfc2253 bbw_ccu)" "$(rule publish "*" "*")" "$(rule subscribe "*" "*")" "intruder" |
   write_if_changed "$DIR/rogue/intruder/permissions.xml"
 sign_doc "$DIR/rogue/ca" "$DIR/rogue/intruder/permissions.xml" "$DIR/rogue/intruder/permissions.p7s"
 

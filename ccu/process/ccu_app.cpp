@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/faults/link_faults.hpp"
 #include "bbw/launch/stats_file.hpp"
@@ -38,11 +39,17 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
       node_(scenario, calibrator, options.friction_feedback, options.monitor),
       periods_(node_.periods()),
       participant_(named(options.participant)),
+      // Commands and calibration state in the run's partition, measurements and health in each
+      // corner's partition of this run (bbw/dds/run_id.hpp): another run on the domain never matches.
       commands_(participant_, dds::kCommandTopic,
-                dds::profiles_for(options.mode == ClockMode::Lockstep).command_writer, events),
-      calibration_(participant_, dds::kCalibrationTopic, "state_writer", events) {
+                dds::profiles_for(options.mode == ClockMode::Lockstep).command_writer, events,
+                dds::Partition{dds::run_partition(options.participant.run_id)}),
+      calibration_(participant_, dds::kCalibrationTopic, "state_writer", events,
+                   dds::Partition{dds::run_partition(options.participant.run_id)}) {
+  node_.set_run_id(options.participant.run_id);
   for (std::size_t i = 0; i < node_.channels(); ++i) {
-    const dds::Partition partition{security::corner_partition(static_cast<int>(node_.channel(i).slot))};
+    const dds::Partition partition{dds::corner_run_partition(
+        security::corner_partition(static_cast<int>(node_.channel(i).slot)), options.participant.run_id)};
     blocks_.push_back(std::make_unique<BlockInlet>(
         participant_, dds::kMeasurementTopic,
         dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_reader, events, partition));
@@ -281,6 +288,8 @@ void CcuApp::write_stats(const std::string& file) const {
   w.set("qos_events_dropped", static_cast<unsigned long long>(dropped));
   w.set("foreign_corner_samples", static_cast<unsigned long long>(foreign));
   w.set("unknown_corner_blocks", static_cast<unsigned long long>(node_.unknown_corner_blocks()));
+  w.set("foreign_run_samples", static_cast<unsigned long long>(node_.foreign_run_samples()));
+  w.set("foreign_runs", dds::join_peer_tags(participant_.foreign_runs()));
   w.set("command_write_failures", static_cast<unsigned long long>(commands_.get().write_failures()));
   std::string corners;
   for (std::size_t i = 0; i < node_.channels(); ++i) corners += (corners.empty() ? "" : ",") + std::string(corner_name(node_.channel(i).corner));

@@ -5,9 +5,12 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
+#include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/launch/stats_file.hpp"
 #include "bbw/node/csv_log.hpp"
@@ -27,7 +30,13 @@ node::CornerNodeOptions node_options(const CornerOptions& o) {
   n.watchdog = o.watchdog;
   n.incarnation = o.incarnation;
   n.resume_at_s = o.resume_at_s;
+  n.run_id = o.participant.run_id;
   return n;
+}
+
+std::string own_partition(const CornerOptions& o) {
+  return dds::corner_run_partition(security::corner_partition(static_cast<int>(dds::corner_index(o.corner))),
+                                   o.participant.run_id);
 }
 
 dds::ParticipantOptions named(dds::ParticipantOptions p, dds::Corner c) {
@@ -43,20 +52,22 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       events_(events),
       node_(scenario, node_options(options)),
       participant_(named(options.participant, options.corner)),
-      // Measurements and health in the corner's own partition (corner_FL, ...), secure or not:
-      // the permissions grant a corner only that one (docs/security.md).
+      // Measurements and health in the corner's own partition of this run (corner_FL.run_<id>,
+      // bbw/dds/run_id.hpp), secure or not: the permissions grant a corner only its own
+      // (docs/security.md). Commands and calibration state in the run's partition run_<id>.
       blocks_(participant_, dds::kMeasurementTopic,
               dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_writer, events,
-              dds::Partition{security::corner_partition(static_cast<int>(dds::corner_index(options.corner)))}),
-      health_(participant_, dds::kHealthTopic, "state_writer", events,
-              dds::Partition{security::corner_partition(static_cast<int>(dds::corner_index(options.corner)))}),
+              dds::Partition{own_partition(options)}),
+      health_(participant_, dds::kHealthTopic, "state_writer", events, dds::Partition{own_partition(options)}),
       // No DDS content filter on these topics: Fast DDS 2.9 evaluates DDS-SQL filters on the
       // writer by deserialising into DynamicData, which throws and catches internally on every
       // sample and made the CCU's command writes its largest cost. The node drops the other
       // corners' samples instead (4 commands per period, a few bytes each).
       commands_(participant_, dds::kCommandTopic,
-                dds::profiles_for(options.mode == ClockMode::Lockstep).command_reader, events),
-      calibration_(participant_, dds::kCalibrationTopic, "state_reader", events) {
+                dds::profiles_for(options.mode == ClockMode::Lockstep).command_reader, events,
+                dds::Partition{dds::run_partition(options.participant.run_id)}),
+      calibration_(participant_, dds::kCalibrationTopic, "state_reader", events,
+                   dds::Partition{dds::run_partition(options.participant.run_id)}) {
   if (!options.periods_log.empty()) {
     periods_log_ = std::make_unique<node::CornerPeriodsLog>(options.periods_log, options.incarnation);
     node_.set_observer(periods_log_.get());
@@ -87,6 +98,21 @@ double CornerApp::sim_now_s() const {
          std::chrono::duration<double>(Clock::now() - t0_).count();
 }
 
+// Who sent the last command taken: its run id, its writer's GUID, and (until the gate has pinned
+// the CCU's writer) whether the writer's participant announced itself as this run's bbw_ccu.
+corner::CommandSource CornerApp::command_source() const {
+  corner::CommandSource source{command_in_.run_id(), {}, false};
+  const auto& handle = commands_.last_info().publication_handle;
+  for (std::size_t i = 0; i < source.writer.size(); ++i) source.writer[i] = handle.value[i];
+  if (!node_.gate().pinned()) {  // the announcement matters only until the CCU's writer is pinned
+    std::array<std::uint8_t, 12> prefix{};
+    std::copy_n(source.writer.begin(), prefix.size(), prefix.begin());
+    const auto tag = participant_.peer_tag(prefix);
+    source.announced_as_ccu = tag && tag->run_id == participant_.run_id() && tag->name == "bbw_ccu";
+  }
+  return source;
+}
+
 bool CornerApp::ccu_gone() const {
   return (commands_.get().liveliness_lost() > 0 && commands_.get().alive_writers() == 0) || commands_.peers() == 0;
 }
@@ -94,7 +120,11 @@ bool CornerApp::ccu_gone() const {
 // Takes every waiting command and calibration state into the node.
 void CornerApp::drain_inputs() {
   // Members, not locals: a message's default constructor re-registers its TypeObject.
-  while (commands_.take(command_in_)) node_.on_command(command_in_, started_ ? sim_now_s() : 0.0);
+  transport::EndpointId from = 0;
+  while (commands_.take(command_in_, from)) {
+    if (command_in_.corner_id() != dds::corner_index(options_.corner)) continue;  // another corner's
+    node_.on_command(command_in_, command_source(), started_ ? sim_now_s() : 0.0);
+  }
   while (calibration_.take(state_in_)) node_.on_calibration(state_in_);
 }
 
@@ -224,6 +254,13 @@ void CornerApp::write_stats(const std::string& file) const {
   w.set("ccu_lost_s", s.ccu_lost_s);
   w.set("default_force_s", s.default_force_s);
   w.set("wall_s", s.wall_s);
+  const corner::CommandGateCounts& g = node_.gate().counts();
+  w.set("commands_clamped", static_cast<unsigned long long>(g.clamped));
+  w.set("commands_refused_run", static_cast<unsigned long long>(g.refused_run));
+  w.set("commands_refused_source", static_cast<unsigned long long>(g.refused_source));
+  w.set("commands_refused_value", static_cast<unsigned long long>(g.refused_value));
+  w.set("gate_max_force_kN", node_.gate().params().max_force_kN);
+  w.set("foreign_runs", dds::join_peer_tags(participant_.foreign_runs()));
   w.save(file);
 }
 

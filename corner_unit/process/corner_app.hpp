@@ -90,6 +90,7 @@ class CornerApp {
   void publish_health(std::uint8_t status);
   double sim_now_s() const;  // realtime: the corner's simulated time from the wall clock
   bool ccu_gone() const;     // the CCU's command writer lost its liveliness
+  corner::CommandSource command_source() const;
   [[noreturn]] void freeze_for_kill();
   void finish_stats(std::chrono::steady_clock::time_point wall0);
 

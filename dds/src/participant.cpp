@@ -8,10 +8,15 @@
 #include <fastdds/dds/publisher/qos/PublisherQos.hpp>
 #include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
 
+#include <unistd.h>
+
 #include <cstdlib>
+#include <iostream>
 #include <filesystem>
 #include <mutex>
 #include <set>
+
+#include "bbw/dds/run_id.hpp"
 
 #ifndef BBW_DEFAULT_DDS_PROFILES
 #error "BBW_DEFAULT_DDS_PROFILES must be defined by dds/CMakeLists.txt"
@@ -43,7 +48,8 @@ void load_profiles(const std::string& file) {
   loaded.insert(key);
 }
 
-Participant::Participant(const ParticipantOptions& options) : domain_id_(options.domain_id) {
+Participant::Participant(const ParticipantOptions& options)
+    : domain_id_(options.domain_id), run_id_(options.run_id) {
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   // Diagnostics: env BBW_DDS_LOG=warning|info raises Fast DDS's log verbosity (errors only by
   // default; info messages exist only in Fast DDS builds with them compiled in).
@@ -68,7 +74,12 @@ Participant::Participant(const ParticipantOptions& options) : domain_id_(options
   for (const auto& [key, value] : options.properties) {
     qos.properties().properties().emplace_back(key, value);
   }
-  participant_ = factory->create_participant(options.domain_id, qos);
+  {
+    const std::string tag = encode_peer_tag({options.run_id, static_cast<long>(::getpid()), qos.name().to_string()});
+    qos.user_data().setValue(std::vector<eprosima::fastrtps::rtps::octet>(tag.begin(), tag.end()));
+  }
+  // The listener only sees participant discovery (no status callback is routed here).
+  participant_ = factory->create_participant(options.domain_id, qos, this, fdds::StatusMask::none());
   if (participant_ == nullptr) {
     throw DdsError("cannot create DomainParticipant on domain " + std::to_string(options.domain_id) +
                    " with profile '" + options.profile + "'");
@@ -83,10 +94,48 @@ Participant::Participant(const ParticipantOptions& options) : domain_id_(options
 }
 
 Participant::~Participant() {
+  participant_->set_listener(nullptr);
   // Writers and readers are owned (and deleted) by their RAII wrappers, which must not outlive
   // this object; delete_contained_entities() releases whatever remains.
   participant_->delete_contained_entities();
   fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+void Participant::on_participant_discovery(fdds::DomainParticipant* /*participant*/,
+                                           eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) {
+  if (info.status != eprosima::fastrtps::rtps::ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT) return;
+  const auto& data = info.info.m_userData.data_vec();
+  const auto tag = decode_peer_tag(std::string(data.begin(), data.end()));
+  if (!tag) return;
+  {
+    std::array<std::uint8_t, 12> prefix{};
+    for (std::size_t i = 0; i < prefix.size(); ++i) prefix[i] = info.info.m_guid.guidPrefix.value[i];
+    std::lock_guard<std::mutex> lock(foreign_mutex_);
+    peers_[prefix] = *tag;
+  }
+  if (tag->run_id == run_id_) return;
+  {
+    std::lock_guard<std::mutex> lock(foreign_mutex_);
+    for (const auto& f : foreign_) {
+      if (f.run_id == tag->run_id && f.pid == tag->pid && f.name == tag->name) return;
+    }
+    foreign_.push_back({tag->run_id, tag->pid, tag->name});
+  }
+  std::cerr << "another bbw run (run id " << run_id_hex(tag->run_id) << ", pid " << tag->pid << ", " << tag->name
+            << ") is on domain " << domain_id_ << "; run ids keep the two apart (this run: " << run_id_hex(run_id_)
+            << ")" << std::endl;
+}
+
+std::optional<PeerTag> Participant::peer_tag(const std::array<std::uint8_t, 12>& guid_prefix) const {
+  std::lock_guard<std::mutex> lock(foreign_mutex_);
+  const auto it = peers_.find(guid_prefix);
+  if (it == peers_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::vector<ForeignRun> Participant::foreign_runs() const {
+  std::lock_guard<std::mutex> lock(foreign_mutex_);
+  return foreign_;
 }
 
 fdds::Publisher& Participant::publisher(const std::string& partition) {

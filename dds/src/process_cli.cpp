@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "bbw/dds/domain.hpp"
+#include "bbw/dds/run_id.hpp"
 
 namespace bbw::dds {
 
@@ -45,6 +46,12 @@ bool ProcessFlags::take(const std::string& flag, ArgCursor& args) {
   else if (flag == "--dds-participant-profile") options.participant.profile = args.value();
   else if (flag == "--secure") secure_dir = args.value();
   else if (flag == "--process-faults") options.process_faults = true;
+  else if (flag == "--run-id") {
+    const std::string text = args.value();
+    const auto id = parse_run_id(text);
+    if (!id) throw std::invalid_argument("--run-id must be 1 to 16 hex digits, got '" + text + "'");
+    options.participant.run_id = *id;
+  }
   else return false;
   return true;
 }
@@ -58,7 +65,7 @@ std::string process_usage(const std::string& program, const std::string& lead,
                           const std::vector<std::string>& own_lines) {
   const std::string pad(std::string("usage: ").size() + program.size() + 1, ' ');
   std::string text = "usage: " + program + (lead.empty() ? "" : " " + lead) + " --scenario FILE [--domain N] [--mode lockstep|realtime]\n" + pad +
-                     "[--discovery-timeout S] [--peer-timeout S] [--process-faults]\n" + pad +
+                     "[--discovery-timeout S] [--peer-timeout S] [--process-faults] [--run-id HEX]\n" + pad +
                      "[--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--secure KEYS_DIR]\n";
   for (const std::string& line : own_lines) text += pad + line + "\n";
   return text;

@@ -4,9 +4,12 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
+#include <set>
 #include <system_error>
 
 namespace bbw::dds {
@@ -45,6 +48,29 @@ bool older_than(const fs::path& file, std::chrono::seconds min_age) {
   return fs::file_time_type::clock::now() - mtime >= min_age;
 }
 
+// Every file under `dir` that some process maps (from /proc/<pid>/maps). A process whose maps
+// this user may not read (in a container: its pid 1) is taken not to map them: a user's own
+// Fast DDS processes are always readable to it.
+std::set<std::string> mapped_files(const std::string& dir) {
+  std::set<std::string> out;
+  std::error_code ec;
+  const std::string prefix = fs::path(dir).lexically_normal().string() + "/";
+  for (const auto& entry : fs::directory_iterator("/proc", ec)) {
+    const std::string pid = entry.path().filename().string();
+    if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream maps(entry.path() / "maps");
+    std::string line;
+    while (maps && std::getline(maps, line)) {
+      const auto at = line.find(prefix);
+      if (at == std::string::npos) continue;
+      std::string path = line.substr(at);
+      if (const auto del = path.find(" (deleted)"); del != std::string::npos) path.resize(del);
+      out.insert(path);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 ShmCleanupReport cleanup_stale_shm(const std::string& dir, std::chrono::seconds min_age) {
@@ -62,6 +88,43 @@ ShmCleanupReport cleanup_stale_shm(const std::string& dir, std::chrono::seconds 
     }
   }
   const fs::path root(dir);
+  // Files with no lock file at all: a port whose lock files are gone (Fast DDS 2.9 leaves
+  // fastrtps_portN and sem.fastrtps_portN_mutex behind that way) or a segment left so. Nobody
+  // can hold a lock on them, so they are stale when no process maps them and they are old.
+  std::vector<std::string> orphans;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    std::string base;
+    if (name.rfind("fastrtps_", 0) == 0 && !ends_with(name, "_el") && !ends_with(name, "_sl")) {
+      base = name;
+    } else if (name.rfind("sem.fastrtps_", 0) == 0 && ends_with(name, "_mutex")) {
+      base = name.substr(4, name.size() - 4 - 6);
+    } else {
+      continue;
+    }
+    if (groups.count(base) == 0) orphans.push_back(name);
+  }
+  if (!orphans.empty()) {
+    const auto mapped = mapped_files(dir);
+    // Segments first: a semaphore is mapped only while its port is being opened, so it goes
+    // only with a segment that goes too (or that no longer exists).
+    std::set<std::string> kept_segments;
+    std::stable_partition(orphans.begin(), orphans.end(), [](const std::string& n) { return n.rfind("sem.", 0) != 0; });
+    for (const auto& name : orphans) {
+      const bool semaphore = name.rfind("sem.", 0) == 0;
+      const std::string segment = semaphore ? name.substr(4, name.size() - 4 - 6) : name;
+      const std::string path = (fs::path(dir).lexically_normal() / name).string();
+      if (mapped.count(path) > 0 || (semaphore && kept_segments.count(segment) > 0)) {
+        ++report.kept_live;
+        if (!semaphore) kept_segments.insert(segment);
+      } else if (!older_than(root / name, min_age)) {
+        ++report.kept_young;
+        if (!semaphore) kept_segments.insert(segment);
+      } else if (fs::remove(root / name, ec)) {
+        report.removed.push_back(name);
+      }
+    }
+  }
   for (const auto& [base, locks] : groups) {
     // Stale only when every lock file of the resource can be locked exclusively by us.
     std::vector<std::unique_ptr<ExclusiveProbe>> held;

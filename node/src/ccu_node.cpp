@@ -76,6 +76,10 @@ const CornerChannel* CcuNode::channel_of(std::uint8_t wire_id) const {
 
 void CcuNode::on_health(std::size_t i, const msg::CornerHealth& h) {
   CornerChannel& ch = channels_[i];
+  if (h.run_id() != run_id_) {
+    ++foreign_run_samples_;  // another run's (dropped unread)
+    return;
+  }
   if (h.corner_id() != ch.slot) {
     ++ch.foreign_health;  // another corner id in this corner's partition
     return;
@@ -97,6 +101,7 @@ const std::vector<msg::ClampCommand>& CcuNode::commands(std::uint64_t step, bool
     const CornerPlan& p = plans[ch.slot];
     msg::ClampCommand& c = commands_[i];
     c.corner_id(static_cast<std::uint8_t>(ch.slot));
+    c.run_id(run_id_);
     c.seq(ch.command_seq++);
     c.step(step);
     c.time_s(t);
@@ -121,8 +126,9 @@ const std::vector<msg::ClampCommand>& CcuNode::commands(std::uint64_t step, bool
 const std::vector<msg::CalibrationState>& CcuNode::initial_states() {
   initial_.clear();
   for (auto& ch : channels_) {
-    dds::to_msg(core_.supervisor(ch.slot).calibrator(), static_cast<std::uint8_t>(ch.slot), 0, 0.0,
-                initial_.emplace_back());
+    msg::CalibrationState& s = initial_.emplace_back();
+    dds::to_msg(core_.supervisor(ch.slot).calibrator(), static_cast<std::uint8_t>(ch.slot), 0, 0.0, s);
+    s.run_id(run_id_);
   }
   return initial_;
 }
@@ -138,11 +144,16 @@ void CcuNode::publish_calibration(CornerChannel& ch, double time_s) {
   ++ch.calibration_version;
   msg::CalibrationState& state = states_[static_cast<std::size_t>(&ch - channels_.data())];
   dds::to_msg(sup.calibrator(), static_cast<std::uint8_t>(ch.slot), ch.calibration_version, time_s, state);
+  state.run_id(run_id_);
   if (std::find(updates_.begin(), updates_.end(), &state) == updates_.end()) updates_.push_back(&state);
 }
 
 void CcuNode::on_block(std::size_t i, const msg::MeasurementBlock& b, transport::EndpointId writer, double arrival_s) {
   CornerChannel& ch = channels_[i];
+  if (b.run_id() != run_id_) {
+    ++foreign_run_samples_;  // another run's block: dropped before anything reads it or its rate
+    return;
+  }
   if (ch.block_tokens < 1.0) {
     ++ch.blocks_over_rate;  // beyond the corner's rate: dropped unread
     return;

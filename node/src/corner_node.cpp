@@ -38,6 +38,15 @@ const scenario::Scenario& validated(const scenario::Scenario& s, const CornerNod
 
 faults::Target target_of(Corner c) { return static_cast<faults::Target>(corner_index(c)); }
 
+// The caliper's rated clamp force from the plant config; the rate allows the full range in one
+// CCU period.
+corner::CommandGateParams gate_params(const scenario::Scenario& s) {
+  corner::CommandGateParams p;
+  p.max_force_kN = s.plant.rated_clamp_force_kN;
+  p.max_rate_kN_per_s = p.max_force_kN / s.ccu_period_s;
+  return p;
+}
+
 }  // namespace
 
 CornerNode::CornerNode(const scenario::Scenario& scenario, const CornerNodeOptions& options)
@@ -47,12 +56,14 @@ CornerNode::CornerNode(const scenario::Scenario& scenario, const CornerNodeOptio
       steps_per_period_(steps_per_period(scenario)),
       periods_(periods_of(scenario)),
       my_id_(static_cast<std::uint8_t>(corner_index(options.corner))),
+      gate_(options.run_id, gate_params(scenario)),
       injector_(options.schedule, target_of(options.corner),
                 scenario::corner_seed(scenario.seed + 7777, options.scenario_index)),
       link_(options.schedule, target_of(options.corner)),
       watchdog_(options.watchdog),
       resume_step_(static_cast<std::uint64_t>(std::ceil(options.resume_at_s / scenario.ccu_period_s - 1e-9))) {
   block_.corner_id(my_id_);
+  block_.run_id(options.run_id);
   block_.incarnation(options.incarnation);
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
   for (dds::CalibrationModel* m : {&model_, &candidate_}) {
@@ -64,6 +75,7 @@ CornerNode::CornerNode(const scenario::Scenario& scenario, const CornerNodeOptio
 msg::CornerHealth CornerNode::health(std::uint8_t status) const {
   msg::CornerHealth h;
   h.corner_id(my_id_);
+  h.run_id(options_.run_id);
   h.status(status);
   h.samples_published(stats_.samples_published);
   h.blocks_published(stats_.blocks_published);
@@ -78,8 +90,13 @@ msg::CornerHealth CornerNode::health(std::uint8_t status) const {
   return h;
 }
 
-void CornerNode::on_command(const msg::ClampCommand& cmd, double arrival_s) {
+void CornerNode::on_command(const msg::ClampCommand& cmd, const corner::CommandSource& source, double arrival_s) {
   if (cmd.corner_id() != my_id_) return;  // another corner's command (no content filter on the topic)
+  // The command gate (issue 17): this run's, from the CCU matched at start, force within the
+  // caliper's rated range and rate; a refused command is counted and never read further.
+  const corner::GateResult gated = gate_.check(source, cmd.mode() == msg::MODE_FORCE, cmd.clamp_force_kN(), cmd.time_s());
+  if (!gated.applies()) return;
+  const double force_kN = cmd.mode() == msg::MODE_FORCE ? gated.force_kN : cmd.clamp_force_kN();
   ++stats_.commands_received;
   if (last_command_seq_ && cmd.seq() != *last_command_seq_ + 1) {
     stats_.command_seq_gaps += cmd.seq() > *last_command_seq_ ? cmd.seq() - *last_command_seq_ - 1 : 1;
@@ -88,18 +105,23 @@ void CornerNode::on_command(const msg::ClampCommand& cmd, double arrival_s) {
   if (cmd.step() < resume_step_ && !cmd.stop()) return;  // a restarted corner joins at its resume step
   if (!have_command_ || cmd.step() >= latest_command_.step()) {
     latest_command_ = cmd;
+    latest_command_.clamp_force_kN(force_kN);
     have_command_ = true;
     if (cmd.valid() && (cmd.mode() == msg::MODE_FORCE || cmd.mode() == msg::MODE_RELEASE)) {
       // Lockstep (and the start command): the command belongs to its period's start.
       // Realtime: to its arrival on this corner's clock.
       const double at = options_.lockstep || !started_ ? cmd.time_s() : arrival_s;
-      watchdog_.on_command(at, cmd.mode() == msg::MODE_FORCE ? cmd.clamp_force_kN() : 0.0);
+      watchdog_.on_command(at, cmd.mode() == msg::MODE_FORCE ? force_kN : 0.0);
     }
   }
 }
 
 void CornerNode::on_calibration(const msg::CalibrationState& state) {
   if (state.corner_id() != my_id_) return;
+  if (state.run_id() != options_.run_id) {
+    ++stats_.calibrations_rejected;  // another run's
+    return;
+  }
   if (state.version() < model_.version && friction_.started()) return;  // stale
   // Decoded into a spare model sized at construction, then swapped in: no allocation per model.
   if (!dds::from_msg(state, candidate_)) {

@@ -8,6 +8,19 @@ namespace bbw::node {
 
 namespace {
 
+// Who sent a command on the in-memory bus: its run id, the sending endpoint's id as the writer,
+// and whether that endpoint is the CCU's command outlet (the bus knows; over DDS the participant's
+// announcement says it).
+corner::CommandSource command_source(const msg::ClampCommand& c, transport::EndpointId from, transport::EndpointId ccu) {
+  corner::CommandSource s{c.run_id(), {}, from == ccu};
+  for (std::size_t i = 0; i < 8; ++i) s.writer[i] = static_cast<std::uint8_t>(from >> (8 * i));
+  return s;
+}
+
+}  // namespace
+
+namespace {
+
 faults::Target target_of(Corner c) { return static_cast<faults::Target>(corner_index(c)); }
 
 }  // namespace
@@ -29,7 +42,9 @@ InProcessRun::InProcessRun(const scenario::Scenario& scenario, const calibration
     }
     if (!ccu_kill_at_s_) ccu_kill_at_s_ = a.at_s;
   }
+  ccu_command_endpoint_ = next_endpoint_;
   command_out_ = commands_.sender(next_endpoint_++);
+  ccu_.set_run_id(options.run_id);
   calibration_out_ = calibration_.sender(next_endpoint_++);
   corners_.resize(ccu_.channels());
   for (std::size_t i = 0; i < ccu_.channels(); ++i) {
@@ -38,6 +53,7 @@ InProcessRun::InProcessRun(const scenario::Scenario& scenario, const calibration
     o.corner = ccu_.channel(i).corner;
     o.scenario_index = i;  // the CCU's channels are in scenario order
     o.lockstep = true;
+    o.run_id = options_.run_id;
     o.schedule = options.schedule;
     o.watchdog = options.watchdog;
     c.node = std::make_unique<CornerNode>(scenario, o);
@@ -101,6 +117,7 @@ void InProcessRun::kill_corner(CornerEnd& c, std::size_t i) {
   o.corner = c.node->corner();
   o.scenario_index = i;
   o.lockstep = true;
+  o.run_id = options_.run_id;
   o.schedule = options_.schedule;
   o.watchdog = options_.watchdog;
   o.incarnation = c.node->incarnation() + 1;
@@ -119,7 +136,8 @@ void InProcessRun::kill_corner(CornerEnd& c, std::size_t i) {
 void InProcessRun::corner_period(CornerEnd& c, std::uint64_t k) {
   if (c.stopped || c.dead) return;
   // drain_inputs: commands, then calibration states.
-  while (c.command_in->take(command_)) c.node->on_command(command_, 0.0);
+  transport::EndpointId from = 0;
+  while (c.command_in->take(command_, from)) c.node->on_command(command_, command_source(command_, from, ccu_command_endpoint_), 0.0);
   while (c.calibration_in->take(state_)) c.node->on_calibration(state_);
   if (!c.started) {
     if (!c.node->have_command()) return;

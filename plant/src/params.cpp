@@ -67,6 +67,7 @@ void PlantParams::validate() const {
   non_negative("sensors.temperature_noise_C", sensors.temperature_noise_C);
   non_negative("sensors.current_noise_A", sensors.current_noise_A);
   in_range("substeps", substeps, 1, 1000, "must be in [1, 1000]");
+  in_range("rated_clamp_force_kN", rated_clamp_force_kN, 1.0, 1000.0, "must be in [1, 1000] kN");
 }
 
 void EffectsParams::validate() const {

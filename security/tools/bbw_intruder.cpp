@@ -22,7 +22,14 @@
 //
 //   bbw_intruder --as none|rogue|corner [--keys DIR] [--corner FL] [--domain N]
 //                [--duration-s S] [--force-kN F] [--dds-profiles FILE.xml]
-//                [--measurements flood|hostile [--rate-x N]]
+//                [--measurements flood|hostile [--rate-x N]] [--run-id HEX]
+//
+// --run-id HEX: an intruder that knows a run's id (unsecured, anyone on the domain can read
+// the partitions in discovery) writes in that run's partitions and stamps that id on every
+// message (issue 17); without it, commands go partition-less and measurements to corner_<C>,
+// which no run reads since runs have their own partitions. --stamp-run-id HEX stamps another
+// id on the messages while writing in --run-id's partitions (a sample of another run that got
+// into this run's partition: receivers must drop and count it).
 #include <bbw/idl/bbw_msgsPubSubTypes.h>
 
 #include <algorithm>
@@ -39,6 +46,7 @@
 #include "bbw/dds/domain.hpp"
 #include "bbw/dds/events.hpp"
 #include "bbw/dds/participant.hpp"
+#include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/dds/writer.hpp"
 #include "bbw/launch/signals.hpp"
@@ -51,7 +59,7 @@ using BlockT = bbw::msg::MeasurementBlockPubSubType;
 
 constexpr const char* kUsage =
     "usage: bbw_intruder --as none|rogue|corner [--keys DIR] [--corner FL|FR|RL|RR] [--domain N]\n"
-    "                    [--duration-s S] [--force-kN F] [--dds-profiles FILE.xml]\n"
+    "                    [--duration-s S] [--force-kN F] [--dds-profiles FILE.xml] [--run-id HEX [--stamp-run-id HEX]]\n"
     "                    [--measurements flood|hostile [--rate-x N]]\n";
 
 struct Options {
@@ -64,6 +72,9 @@ struct Options {
   std::string profiles_file;
   std::string measurements;  // "", flood, hostile
   int rate_x = 20;
+  std::optional<std::uint64_t> run_id;  // --run-id: write in that run's partitions, with its id
+  std::optional<std::uint64_t> stamp;   // --stamp-run-id: the id written in the messages instead
+  std::uint64_t stamped() const { return stamp.value_or(run_id.value_or(0)); }
 };
 
 // What the measurement modes wrote.
@@ -101,6 +112,7 @@ BlockCounts write_blocks(bbw::dds::Writer<BlockT>& w, bbw::dds::Events& events, 
     const int count = o.measurements == "flood" ? o.rate_x : 1;
     for (int i = 0; i < count; ++i) {
       b.corner_id(corner_id);
+      b.run_id(o.stamped());
       b.block_seq(block++);
       b.incarnation(0);
       b.samples().clear();
@@ -159,6 +171,15 @@ Options parse(int argc, char** argv) {
     else if (k == "--duration-s") o.duration_s = parse_positive(next(), "--duration-s");
     else if (k == "--force-kN") o.force_kN = parse_positive(next(), "--force-kN");
     else if (k == "--dds-profiles") o.profiles_file = next();
+    else if (k == "--run-id") {
+      const std::string v = next();
+      o.run_id = bbw::dds::parse_run_id(v);
+      if (!o.run_id) throw std::invalid_argument("--run-id must be 1 to 16 hex digits, got '" + v + "'");
+    } else if (k == "--stamp-run-id") {
+      const std::string v = next();
+      o.stamp = bbw::dds::parse_run_id(v);
+      if (!o.stamp) throw std::invalid_argument("--stamp-run-id must be 1 to 16 hex digits, got '" + v + "'");
+    }
     else if (k == "--measurements") o.measurements = next();
     else if (k == "--rate-x") {
       const double r = parse_positive(next(), "--rate-x");
@@ -229,7 +250,8 @@ int main(int argc, char** argv) {
       try {
         bw = std::make_unique<bbw::dds::Writer<BlockT>>(
             participant, bbw::dds::kMeasurementTopic, "measurement_writer_realtime", events,
-            bbw::dds::Partition{bbw::security::corner_partition(corner_id)});
+            bbw::dds::Partition{o.run_id ? bbw::dds::corner_run_partition(bbw::security::corner_partition(corner_id), *o.run_id)
+                                         : bbw::security::corner_partition(corner_id)});
         writer_ok = true;
       } catch (const bbw::dds::DdsError& e) {
         refused = e.what();
@@ -246,8 +268,9 @@ int main(int argc, char** argv) {
         bw->get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
       }
     } else try {
-      writer = std::make_unique<bbw::dds::Writer<CommandT>>(participant, bbw::dds::kCommandTopic,
-                                                            "command_writer_realtime", events);
+      writer = std::make_unique<bbw::dds::Writer<CommandT>>(
+          participant, bbw::dds::kCommandTopic, "command_writer_realtime", events,
+          bbw::dds::Partition{o.run_id ? bbw::dds::run_partition(*o.run_id) : std::string()});
       writer_ok = true;
     } catch (const bbw::dds::DdsError& e) {
       refused = e.what();
@@ -263,6 +286,7 @@ int main(int argc, char** argv) {
         for (std::uint8_t c = 0; c < 4; ++c) {
           bbw::msg::ClampCommand cmd;
           cmd.corner_id(c);
+          cmd.run_id(o.stamped());
           cmd.seq(++seq);
           cmd.step(seq);
           cmd.clamp_force_kN(o.force_kN);

@@ -15,6 +15,9 @@ namespace bbw::node {
 
 namespace {
 
+// The CCU's writer as the corners see it in these tests (run id 0, announced as the CCU).
+const corner::CommandSource kCcu{0, {1}, true};
+
 faults::FaultScenario load(const std::string& rel) { return faults::load_fault_scenario(test::source_path(rel)); }
 
 CornerNodeOptions options_for(const scenario::Scenario& s, std::size_t index) {
@@ -28,7 +31,7 @@ CornerNodeOptions options_for(const scenario::Scenario& s, std::size_t index) {
 void period(CcuNode& ccu, std::vector<std::unique_ptr<CornerNode>>& corners, std::uint64_t k) {
   const auto& cmds = ccu.commands(k, false);
   for (auto& c : corners) {
-    for (const auto& cmd : cmds) c->on_command(cmd, 0.0);
+    for (const auto& cmd : cmds) c->on_command(cmd, kCcu, 0.0);
     for (const msg::CalibrationState* s : ccu.calibration_updates()) c->on_calibration(*s);
     if (k == 0) c->start();
   }
@@ -63,10 +66,10 @@ TEST(CornerNode, TakesOnlyItsOwnCommandsAndSimulatesAGrantedPeriod) {
   c.corner_id(static_cast<std::uint8_t>(Corner::FR));
   c.step(0);
   c.valid(true);
-  fl.on_command(c, 0.0);
+  fl.on_command(c, kCcu, 0.0);
   EXPECT_FALSE(fl.have_command());  // another corner's
   c.corner_id(static_cast<std::uint8_t>(fl.corner()));
-  fl.on_command(c, 0.0);
+  fl.on_command(c, kCcu, 0.0);
   ASSERT_TRUE(fl.have_command());
   EXPECT_TRUE(fl.granted(0));
   EXPECT_FALSE(fl.granted(1));
@@ -78,7 +81,7 @@ TEST(CornerNode, TakesOnlyItsOwnCommandsAndSimulatesAGrantedPeriod) {
   for (std::size_t i = 0; i < b->samples().size(); ++i) EXPECT_EQ(b->samples()[i].seq(), i + 1);
   c.seq(5);  // 1..4 never came
   c.step(1);
-  fl.on_command(c, 0.0);
+  fl.on_command(c, kCcu, 0.0);
   EXPECT_EQ(fl.stats().command_seq_gaps, 4u);
 }
 

@@ -7,6 +7,8 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -50,6 +52,53 @@ inline ProcessRun run(const std::string& name, const std::vector<std::string>& a
   if (!status) status = child.stop(2000ms);
   return {*status, slurp(dir + "/" + name + ".stdout"), slurp(dir + "/" + name + ".stderr"), dir};
 }
+
+// A process (bbw_launch, bbw_intruder, ...) started now and not yet waited for, its output in
+// dir/<name>.stdout and .stderr. Every wait is bounded.
+class Launch {
+ public:
+  Launch(const std::string& dir, const std::string& name, const std::vector<std::string>& argv,
+         const std::vector<std::string>& env = {})
+      : dir_(dir), name_(name) {
+    std::filesystem::create_directories(dir);
+    child_ = std::make_unique<bbw::launch::Child>(name, argv, stdout_file(), dir + "/" + name + ".stderr", env);
+  }
+  std::string stdout_file() const { return dir_ + "/" + name_ + ".stdout"; }
+  std::string err() const { return slurp(dir_ + "/" + name_ + ".stderr"); }
+  std::string out() const { return slurp(stdout_file()); }
+  pid_t pid() const { return child_->pid(); }
+  // Waits (bounded) until its stdout matches `re`; the first group ("" on timeout or its end).
+  std::string wait_for_output(const std::regex& re, std::chrono::seconds limit) {
+    const auto end = std::chrono::steady_clock::now() + limit;
+    while (std::chrono::steady_clock::now() < end) {
+      std::smatch m;
+      const std::string text = out();
+      if (std::regex_search(text, m, re)) return m.size() > 1 ? m[1].str() : m[0].str();
+      if (child_->wait_until(std::chrono::steady_clock::now() + std::chrono::milliseconds(20))) {
+        std::smatch last;
+        const std::string all = out();  // ended: one last look
+        return std::regex_search(all, last, re) ? (last.size() > 1 ? last[1].str() : last[0].str()) : "";
+      }
+    }
+    return "";
+  }
+  // The launcher's run id once printed ("bbw_launch: ..., run id <16 hex>, ..."; "" if never).
+  std::string run_id(std::chrono::seconds limit = std::chrono::seconds(30)) { return wait_for_output(std::regex("run id ([0-9a-f]{16})"), limit); }
+  bbw::launch::ExitStatus wait(std::chrono::seconds limit) {
+    auto st = child_->wait_until(std::chrono::steady_clock::now() + limit);
+    if (!st) st = child_->stop(std::chrono::milliseconds(3000));
+    return *st;
+  }
+  void signal(int sig) { child_->send_signal(sig); }
+  // A bounded wait on its end: true when it has ended.
+  bool ended_within(std::chrono::milliseconds d) {
+    return child_->wait_until(std::chrono::steady_clock::now() + d).has_value();
+  }
+
+ private:
+  std::string dir_, name_;
+  std::unique_ptr<bbw::launch::Child> child_;
+};
 
 // The Fast DDS 2.9 discovery abort (docs/faults.md, "Realtime restart"): a process that joins a
 // domain where a participant has just died can abort in Fast DDS's own PDP code

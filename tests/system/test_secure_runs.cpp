@@ -27,6 +27,7 @@ namespace {
 using namespace std::chrono_literals;
 using bbw::system_test::bin;
 using bbw::system_test::fastdds_pdp_abort;
+using bbw::system_test::Launch;
 using bbw::system_test::ProcessRun;
 using bbw::system_test::slurp;
 using bbw::system_test::src;
@@ -57,6 +58,29 @@ std::vector<std::string> launch_argv(const std::string& dir, int domain, const s
 
 ProcessRun launch(const std::string& dir, int domain, const std::string& mode, bool secure) {
   return run("bbw_launch", launch_argv(dir, domain, mode, secure), dir, 150s);
+}
+
+// Lines in a file so far (0 when it does not exist).
+[[maybe_unused]] std::size_t lines_in(const std::string& file) {
+  std::ifstream f(file);
+  std::size_t n = 0;
+  std::string line;
+  while (std::getline(f, line)) ++n;
+  return n;
+}
+
+// A launcher started now; intruders that know its run id (issue 17: runs have their own DDS
+// partitions, so an intruder must know the run id to reach it) start once it is printed.
+[[maybe_unused]] std::unique_ptr<Launch> start_launch(const std::string& dir, int domain, const std::string& mode,
+                                                      bool secure) {
+  return std::make_unique<Launch>(dir, "bbw_launch", launch_argv(dir, domain, mode, secure),
+                                  std::vector<std::string>{"BBW_DDS_LOG=warning"});
+}
+
+// Waits (bounded) for a launcher started by start_launch(), as launch() would have run it.
+[[maybe_unused]] ProcessRun finish_launch(Launch& l) {
+  const bbw::launch::ExitStatus st = l.wait(150s);
+  return {st, l.out(), l.err(), ""};
 }
 
 double stat(const std::string& file, const std::string& key) {
@@ -199,11 +223,22 @@ TEST(SystemSecure, IntrudersNeverCommandACornerOfASecureRun) {
     a.insert(a.end(), common.begin(), common.end());
     return a;
   };
-  Intruder none(dir, "intruder_none", args({"--as", "none"}));
-  Intruder rogue(dir, "intruder_rogue", args({"--as", "rogue"}));
-  Intruder corner(dir, "intruder_corner", args({"--as", "corner", "--corner", "FL"}));
-  const ProcessRun r = launch(dir, 223, "lockstep", true);
-  // The intruders were there for the whole run.
+  // The intruders know the run id (as they could read it in discovery): only security stops them.
+  // They join once the run is under way (the CCU logs samples): joining while the five secure
+  // participants still shake hands made Fast DDS 2.9's handshake race (below) leave three
+  // corners unauthenticated for the whole 20 s discovery deadline (1 of 2 full-suite runs).
+  auto l = start_launch(dir, 223, "lockstep", true);
+  const std::string run_id = l->run_id();
+  ASSERT_EQ(run_id.size(), 16u) << l->out() << l->err();
+  const auto underway = Clock::now() + 60s;
+  while (Clock::now() < underway && lines_in(dir + "/out/ccu_FL.csv") < 50 && !l->ended_within(20ms)) {
+  }
+  ASSERT_GE(lines_in(dir + "/out/ccu_FL.csv"), 50u) << "the run never got under way\n" << l->out() << l->err();
+  Intruder none(dir, "intruder_none", args({"--as", "none", "--run-id", run_id}));
+  Intruder rogue(dir, "intruder_rogue", args({"--as", "rogue", "--run-id", run_id}));
+  Intruder corner(dir, "intruder_corner", args({"--as", "corner", "--corner", "FL", "--run-id", run_id}));
+  const ProcessRun r = finish_launch(*l);
+  // The intruders were there until the end of the run.
   EXPECT_TRUE(none.running() && rogue.running()) << "the run outlasted the intruders: make --duration-s longer";
   ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
   expect_clean_lockstep_run(dir + "/out");
@@ -213,7 +248,7 @@ TEST(SystemSecure, IntrudersNeverCommandACornerOfASecureRun) {
   const std::string jn = none.finish(20s), jr = rogue.finish(20s), jc = corner.finish(20s);
   for (const std::string* j : {&jn, &jr}) {
     EXPECT_TRUE(json_true(*j, "participant") && json_true(*j, "writer")) << *j;
-    EXPECT_GT(json_number(*j, "written"), 1000.0) << *j;
+    EXPECT_GT(json_number(*j, "written"), 400.0) << *j;
     EXPECT_EQ(json_number(*j, "max_matched"), 0.0) << *j;
   }
   EXPECT_TRUE(json_true(jc, "participant")) << jc;
@@ -222,14 +257,11 @@ TEST(SystemSecure, IntrudersNeverCommandACornerOfASecureRun) {
   fs::remove_all(dir);
 }
 
-// Domain 224, the positive control of the test above: without security the same unsecured
-// intruder does reach the corners, which then apply its force (so the checks above can fail).
-// Realtime, not lockstep: the intruder numbers its commands 800 steps per wall-clock second
-// from its own start, and a lockstep run on a fast machine overtakes that numbering within a
-// second (the corners keep the newest step), so whether a lockstep corner ever applied the
-// intruder's command depended on the machine's speed. In realtime the run lasts its 4 s and
-// the intruder's steps stay ahead of the CCU's 200 per second for all of it.
-TEST(SystemSecure, WithoutSecurityAnIntruderCommandsTheCorners) {
+// Domain 224: without security, an intruder that does not know the run id (it writes
+// partition-less commands, as before issue 17) matches no corner: each run reads commands only
+// in its own partition run_<id>. The positive control, an unsecured intruder that does know the
+// run id and reaches every corner (which then refuse it), is SystemGate in test_run_safety.cpp.
+TEST(SystemSecure, WithoutSecurityAnIntruderThatDoesNotKnowTheRunReachesNoCorner) {
   const std::string dir = scratch("unprotected");
   Intruder none(dir, "intruder_none", {"--as", "none", "--domain", "224", "--duration-s", "60", "--force-kN", "77.7"});
   const ProcessRun r = launch(dir, 224, "realtime", false);
@@ -237,9 +269,10 @@ TEST(SystemSecure, WithoutSecurityAnIntruderCommandsTheCorners) {
   ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
   std::size_t applied = 0;
   for (const char* c : kCorners) applied += periods_with_intruder_force(dir + "/out", c);
-  EXPECT_GT(applied, 0u) << "an unsecured intruder's command was never applied: the check cannot see one";
+  EXPECT_EQ(applied, 0u) << "an intruder without the run id commanded a corner";
   const std::string j = none.finish(20s);
-  EXPECT_GE(json_number(j, "max_matched"), 4.0) << j;
+  EXPECT_GT(json_number(j, "written"), 400.0) << j;
+  EXPECT_EQ(json_number(j, "max_matched"), 0.0) << j;
   fs::remove_all(dir);
 }
 
@@ -250,9 +283,12 @@ TEST(SystemSecure, WithoutSecurityAnIntruderCommandsTheCorners) {
 // other corners are untouched.
 TEST(SystemHostileInput, MalformedMeasurementsAreRejectedAndCounted) {
   const std::string dir = scratch("hostile");
-  Intruder hostile(dir, "intruder_hostile",
-                   {"--as", "none", "--corner", "FL", "--measurements", "hostile", "--domain", "225", "--duration-s", "60"});
-  const ProcessRun r = launch(dir, 225, "realtime", false);
+  auto l = start_launch(dir, 225, "realtime", false);
+  const std::string run_id = l->run_id();
+  ASSERT_EQ(run_id.size(), 16u) << l->out() << l->err();
+  Intruder hostile(dir, "intruder_hostile", {"--as", "none", "--corner", "FL", "--measurements", "hostile", "--domain", "225",
+                                             "--duration-s", "60", "--run-id", run_id});
+  const ProcessRun r = finish_launch(*l);
   ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
   const std::string j = hostile.finish(20s);
   ASSERT_GE(json_number(j, "max_matched"), 1.0) << j;
@@ -317,10 +353,13 @@ TEST(SystemHostileInput, AFloodingCornerDoesNotDelayTheOthersCommands) {
   for (int attempt = 1; attempt <= kAttempts && !deadlines_held; ++attempt) {
     const std::string dir = scratch("flood_" + std::to_string(attempt));
     const std::string domain = std::to_string(domains[attempt - 1]);
+    auto l = start_launch(dir, domains[attempt - 1], "realtime", false);
+    const std::string run_id = l->run_id();
+    ASSERT_EQ(run_id.size(), 16u) << l->out() << l->err();
     Intruder flood(dir, "intruder_flood", {"--as", "none", "--corner", "FL", "--measurements", "flood", "--rate-x", "20",
-                                           "--domain", domain, "--duration-s", "60"},
+                                           "--domain", domain, "--duration-s", "60", "--run-id", run_id},
                    true);
-    const ProcessRun r = launch(dir, domains[attempt - 1], "realtime", false);
+    const ProcessRun r = finish_launch(*l);
     const bool flood_lasted = flood.running();
     const bbw::launch::ExitStatus flood_status = flood.stop(20s);
     const std::string out = dir + "/out", ccu = out + "/ccu.stats";

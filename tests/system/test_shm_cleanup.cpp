@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -76,6 +77,37 @@ TEST_F(ShmDir, RemovesDeadOwnersFilesAndKeepsLiveAndYoungOnes) {
   EXPECT_EQ(report.removed.size(), 6u);
   ::close(fd);
   ::close(fd_sh);
+}
+
+}  // namespace
+
+namespace {
+
+// Fast DDS 2.9 leaves port segments and their semaphores with no lock file (issue 17: 8 of
+// each after a killed CCU). Nobody maps them: stale once old. A mapped one is live.
+TEST_F(ShmDir, RemovesOrphanPortFilesNobodyMapsAndKeepsMappedOnes) {
+  touch("fastrtps_port7511", true);
+  touch("sem.fastrtps_port7511_mutex", true);
+  touch("fastrtps_port7513", false);  // young
+  touch("fastrtps_port7515", true);   // mapped by this process: live
+  touch("sem.fastrtps_port7515_mutex", true);  // not mapped, but its port is live: kept
+  const int fd = ::open((dir_ / "fastrtps_port7515").c_str(), O_RDONLY);
+  ASSERT_GE(fd, 0);
+  void* map = ::mmap(nullptr, 1, PROT_READ, MAP_SHARED, fd, 0);
+  ASSERT_NE(map, MAP_FAILED);
+
+  const auto report = bbw::dds::cleanup_stale_shm(dir_.string(), std::chrono::seconds(2));
+
+  EXPECT_FALSE(exists("fastrtps_port7511"));
+  EXPECT_FALSE(exists("sem.fastrtps_port7511_mutex"));
+  EXPECT_TRUE(exists("fastrtps_port7513"));
+  EXPECT_TRUE(exists("fastrtps_port7515"));
+  EXPECT_TRUE(exists("sem.fastrtps_port7515_mutex"));
+  EXPECT_EQ(report.removed.size(), 2u);
+  EXPECT_EQ(report.kept_young, 1u);
+  EXPECT_EQ(report.kept_live, 2u);
+  ::munmap(map, 1);
+  ::close(fd);
 }
 
 }  // namespace

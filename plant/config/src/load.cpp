@@ -91,6 +91,7 @@ PlantParams read_plant_params(Reader& r) {
     p.sensors = read_sensors(s, p.sensors, true);
   }
   p.substeps = static_cast<int>(r.integer_or("substeps", p.substeps, 1, 1000));
+  p.rated_clamp_force_kN = r.number_or("rated_clamp_force_kN", p.rated_clamp_force_kN, Range::closed(1.0, 1000.0));
   r.finish();
   checked(r, [&] { p.validate(); });
   return p;

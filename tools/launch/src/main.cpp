@@ -12,7 +12,16 @@
 // output in DIR/<name>.out/.err, waits for them to finish within a bounded wall time, and
 // writes DIR/summary.json and DIR/report.html. If a process dies or fails (discovery timeout,
 // lost peer), the others are stopped and the launcher exits non-zero naming the process and
-// the reason. Exit: 0 ok, 1 a process failed or the run exceeded its bound, 2 bad arguments.
+// the reason, after a partial summary from what the processes logged (partial_summary.hpp).
+// SIGINT/SIGTERM stop the run the same way, with a partial summary marked interrupted.
+// Exit: 0 ok, 1 a process failed or the run exceeded its bound, 2 bad arguments, 130/143
+// stopped by SIGINT/SIGTERM.
+//
+// Each run draws a random run id (/dev/urandom) that every child gets as --run-id: its DDS
+// partitions and messages carry it, so runs on one domain never mix (docs/distributed.md,
+// "Runs on one host"). Without --domain and BBW_DOMAIN a free domain is chosen
+// (domain_claim.hpp). DIR is created, or cleared of an older run's files, or refused when it
+// holds files bbw did not write (out_dir.hpp).
 //
 // Process faults of the scenario's schedule (docs/faults.md) are carried out here: a process
 // freezes itself (SIGSTOP) at its scheduled kill time (lockstep: the period; realtime: its wall
@@ -21,8 +30,11 @@
 // realtime: restart_after_s of wall time later). A scheduled kill is not a failure: after a CCU
 // kill the corners run to the end in their safe state and the run is reported as ended by the
 // injected fault. Any other death is an error naming the process.
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -40,6 +52,7 @@
 #include "bbw/common/json.hpp"
 #include "bbw/dds/domain.hpp"
 #include "bbw/dds/process_cli.hpp"
+#include "bbw/dds/run_id.hpp"
 #include "bbw/dds/shm_cleanup.hpp"
 #include "bbw/faults/link_faults.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
@@ -49,7 +62,10 @@
 #include "bbw/scenario/load.hpp"
 #include "bbw/scenario/run_checks.hpp"
 #include "bbw/security/dds_security.hpp"
+#include "domain_claim.hpp"
 #include "fault_report.hpp"
+#include "out_dir.hpp"
+#include "partial_summary.hpp"
 #include "report.hpp"
 #include "summary.hpp"
 
@@ -90,7 +106,11 @@ std::string reason(const bbw::launch::ExitStatus& s) {
 int main(int argc, char** argv) {
   std::vector<std::unique_ptr<Child>> children;
   std::atomic<bool> interrupted{false};
-  bbw::launch::SignalWatcher signals([&](int) { interrupted.store(true); });
+  std::atomic<int> stop_signal{0};
+  bbw::launch::SignalWatcher signals([&](int sig) {
+    stop_signal.store(sig);
+    interrupted.store(true);
+  });
 
   std::string scenario_file, out_dir, mode = "lockstep", feedback = "on";
   std::optional<std::string> domain_arg;
@@ -122,11 +142,26 @@ int main(int argc, char** argv) {
     if (scenario_file.empty()) throw std::invalid_argument("a scenario file is required");
     if (out_dir.empty()) throw std::invalid_argument("--out DIR is required");
     if (feedback != "on" && feedback != "off") throw std::invalid_argument("--friction-feedback must be on or off");
-    domain = bbw::dds::resolve_domain_id(domain_arg, std::getenv("BBW_DOMAIN"));
+    domain = bbw::dds::resolve_domain_id(domain_arg, std::getenv("BBW_DOMAIN"), -1);
   } catch (const std::exception& e) {
     std::cerr << "bbw_launch: " << e.what() << "\n" << kUsage;
     return 2;
   }
+  // The run id (never the scenario seed): every child gets it, every endpoint lives in
+  // partitions derived from it, every message carries it (bbw/dds/run_id.hpp).
+  std::uint64_t run_id = 0;
+  bbw::launch::DomainClaim domain_claim;
+  try {
+    run_id = bbw::dds::random_run_id();
+    if (domain < 0) {  // neither --domain nor BBW_DOMAIN: a free one (domain_claim.hpp)
+      domain_claim = bbw::launch::claim_free_domain(run_id);
+      domain = domain_claim.domain();
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "bbw_launch: " << e.what() << "\n";
+    return 1;
+  }
+  const std::string run_hex = bbw::dds::run_id_hex(run_id);
 
   // Validate the scenario before starting anything.
   std::optional<bbw::scenario::Scenario> scenario;
@@ -146,22 +181,43 @@ int main(int argc, char** argv) {
     std::cerr << "bbw_launch: " << e.what() << "\n";
     return 2;
   }
-  ::mkdir(out_dir.c_str(), 0755);
-  struct stat st {};
-  if (::stat(out_dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
-    std::cerr << "bbw_launch: cannot create output directory " << out_dir << "\n";
+  try {
+    const auto cleared = bbw::launch::prepare_out_dir(out_dir);
+    if (!cleared.removed.empty()) {
+      std::cout << "bbw_launch: removed " << cleared.removed.size() << " files of an older run from " << out_dir
+                << std::endl;
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "bbw_launch: " << e.what() << "\n";
     return 2;
   }
   if (secure) {
     // Keys: created by scripts/bbw-keys.sh when any file is missing (idempotent), then checked.
     std::error_code ec;
     keys_dir = std::filesystem::absolute(keys_dir, ec).lexically_normal().string();
+    // One launcher at a time checks and creates the keys of a directory (two runs started at
+    // once must not both write it): an flock on a lock file named after it, held until here ends.
+    const std::string keys_lock = "/tmp/bbw-keys-" + std::to_string(std::hash<std::string>{}(keys_dir)) + ".lock";
+    const int keys_lock_fd = ::open(keys_lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (keys_lock_fd < 0 || ::flock(keys_lock_fd, LOCK_EX) != 0) {
+      std::cerr << "bbw_launch: cannot lock " << keys_lock << " for the keys in " << keys_dir << "\n";
+      return 1;
+    }
+    struct CloseLock {
+      int fd;
+      ~CloseLock() { ::close(fd); }
+    } close_keys_lock{keys_lock_fd};
     auto check_keys = [&]() -> std::string {
       try {
         for (const auto& id : bbw::security::identities()) bbw::security::files_for(keys_dir, id);
       } catch (const std::exception& e) {
         return e.what();
       }
+      // Permissions written before runs had their own partitions (issue 17) grant no run_*
+      // partition: scripts/bbw-keys.sh re-signs them (it keeps every key that still verifies).
+      std::ifstream perm(keys_dir + "/fl/permissions.xml");
+      const std::string text((std::istreambuf_iterator<char>(perm)), std::istreambuf_iterator<char>());
+      if (text.find("run_*") == std::string::npos) return keys_dir + "/fl/permissions.xml grants no per-run partition";
       return "";
     };
     if (!check_keys().empty()) {
@@ -211,7 +267,7 @@ int main(int argc, char** argv) {
   std::map<std::string, unsigned> incarnations;  // corner -> processes started
   auto spawn_corner = [&](const std::string& c, unsigned incarnation, double resume_at_s) {
     std::vector<std::string> argv{corner_bin, "--corner", c, "--scenario", scenario_file, "--domain", dom,
-                                  "--mode", mode, "--stats", corner_stats_file(c, incarnation),
+                                  "--run-id", run_hex, "--mode", mode, "--stats", corner_stats_file(c, incarnation),
                                   "--periods-log", out_dir + "/corner_" + c + "_periods.csv",
                                   "--discovery-timeout", disc};
     if (process_faults) {
@@ -232,7 +288,7 @@ int main(int argc, char** argv) {
     incarnations[c] = incarnation + 1;
   };
   try {
-    std::vector<std::string> ccu_argv{bin + "/bbw_ccu", "--scenario", scenario_file, "--domain", dom, "--mode", mode,
+    std::vector<std::string> ccu_argv{bin + "/bbw_ccu", "--scenario", scenario_file, "--domain", dom, "--run-id", run_hex, "--mode", mode,
                                       "--out", out_dir, "--discovery-timeout", disc, "--friction-feedback", feedback};
     if (process_faults) ccu_argv.push_back("--process-faults");
     if (secure) ccu_argv.insert(ccu_argv.end(), {"--secure", keys_dir});
@@ -244,7 +300,8 @@ int main(int argc, char** argv) {
     for (auto& c : children) c->stop(2000ms);
     return 1;
   }
-  std::cout << "bbw_launch: " << scenario->name << ", " << mode << ", domain " << domain << ", "
+  std::cout << "bbw_launch: " << scenario->name << ", " << mode << ", domain " << domain
+            << (domain_claim.domain() >= 0 ? " (chosen free)" : "") << ", run id " << run_hex << ", "
             << children.size() << " processes, discovery deadline " << discovery_s << " s"
             << (process_faults ? ", process faults scheduled" : "") << std::endl;
 
@@ -282,7 +339,7 @@ int main(int argc, char** argv) {
     for (auto& c : children) raw.push_back(c.get());
     bbw::launch::wait_any(raw, wake);
     if (interrupted.load()) {
-      failure = "interrupted by signal";
+      failure = std::string("interrupted by ") + (stop_signal.load() == SIGINT ? "SIGINT" : "SIGTERM");
       break;
     }
     // A process that froze itself at its scheduled kill: kill it now.
@@ -352,9 +409,45 @@ int main(int argc, char** argv) {
     }
   }
   if (!failure.empty()) {
+    // Which processes ended on their own (the lost ones, unless scheduled) before the others
+    // are stopped; then a partial summary from whatever each process logged.
+    std::vector<bbw::launch::ProcessEnd> ends;
+    for (auto& c : children) {
+      bbw::launch::ProcessEnd e;
+      e.name = c->name();
+      e.ended_by_itself = c->poll().has_value();
+      e.scheduled_kill = killed_by_schedule.count(c.get()) > 0;
+      ends.push_back(e);
+    }
     for (auto& c : children) c->stop(3000ms);
+    for (std::size_t i = 0; i < children.size(); ++i) {
+      ends[i].status = children[i]->status() ? children[i]->status()->describe() : std::string("unknown");
+      ends[i].ok = children[i]->status() && children[i]->status()->ok();
+      ends[i].exit_code = children[i]->status() && children[i]->status()->exited ? children[i]->status()->code : -1;
+    }
+    const int sig = stop_signal.load();
     std::cerr << "bbw_launch: " << failure << " (logs in " << out_dir << ")\n";
-    return 1;
+    bbw::launch::PartialRun run;
+    run.scenario = &*scenario;
+    run.scenario_file = scenario_file;
+    run.mode = mode;
+    run.domain = domain;
+    run.run_id = run_hex;
+    run.secure = secure;
+    run.out_dir = out_dir;
+    run.failure = failure;
+    run.interrupted = sig != 0;
+    run.signal = sig;
+    run.processes = ends;
+    run.incarnations = incarnations;
+    try {
+      const auto lost = bbw::launch::write_partial_summary(run);
+      for (const auto& name : lost) std::cerr << "bbw_launch: lost process: " << name << "\n";
+      std::cerr << "bbw_launch: partial summary in " << out_dir << "/summary.json\n";
+    } catch (const std::exception& e) {
+      std::cerr << "bbw_launch: partial summary failed: " << e.what() << "\n";
+    }
+    return sig != 0 ? 128 + sig : 1;
   }
   for (const auto& [name, due] : kills_due) {
     if (!due.empty()) {
@@ -385,7 +478,25 @@ int main(int argc, char** argv) {
     std::vector<std::vector<std::pair<double, double>>> period_logs;
     double max_jitter = 0.0;
     j.begin_object().value("scenario", scenario->name).value("scenario_file", scenario_file).value("mode", mode);
-    j.value("domain", domain).value("friction_feedback", feedback).value("secure", secure);
+    j.value("domain", domain).value("run_id", run_hex).value("friction_feedback", feedback).value("secure", secure);
+    j.value("complete", true).value("interrupted", false);
+    // Participants of other bbw runs seen on the domain (by any process of this run).
+    std::vector<bbw::dds::PeerTag> others;
+    {
+      std::vector<std::string> files{ccu_stats_file};
+      for (const auto& [c, n] : incarnations) {
+        for (unsigned k = 0; k < n; ++k) files.push_back(corner_stats_file(c, k));
+      }
+      others = bbw::launch::foreign_runs_in(files);
+    }
+    j.begin_array("other_runs_on_domain");
+    for (const auto& o : others) {
+      j.begin_object().value("run_id", bbw::dds::run_id_hex(o.run_id)).value("pid", static_cast<long long>(o.pid))
+          .value("process", o.name).end_object();
+      std::cerr << "bbw_launch: another bbw run (run id " << bbw::dds::run_id_hex(o.run_id) << ", pid " << o.pid
+                << ", " << o.name << ") is on domain " << domain << "; the run ids kept the two apart\n";
+    }
+    j.end_array();
     j.begin_array("corners");
     for (const auto& c : scenario->corners) {
       // Counters summed over the corner's incarnations (a restarted process has its own file).
@@ -475,6 +586,10 @@ int main(int argc, char** argv) {
           .value("max_jitter_s", corner_max("max_jitter_s"))
           .value("mean_jitter_s", num(cs, "mean_jitter_s", cs_file))
           .value("overruns", static_cast<long long>(corner_sum("overruns")))
+          .value("commands_clamped", static_cast<long long>(corner_sum("commands_clamped")))
+          .value("commands_refused_run", static_cast<long long>(corner_sum("commands_refused_run")))
+          .value("commands_refused_source", static_cast<long long>(corner_sum("commands_refused_source")))
+          .value("commands_refused_value", static_cast<long long>(corner_sum("commands_refused_value")))
           .end_object();
       bbw::launch::ReportCorner rc;
       rc.summary = m;
@@ -500,6 +615,7 @@ int main(int argc, char** argv) {
         .value("command_deadline_misses", cmd_deadlines)
         .value("max_jitter_s", max_jitter)
         .value("overruns", overruns)
+        .value("foreign_run_samples", static_cast<long long>(num(ccu, "foreign_run_samples", ccu_stats_file)))
         .end_object();
     // Injected faults against what was detected, and the total clamp force against demand.
     const auto timeline = bbw::launch::build_timeline(*scenario, period_logs);

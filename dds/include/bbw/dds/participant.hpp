@@ -6,17 +6,24 @@
 #pragma once
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/ContentFilteredTopic.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include <array>
+#include <cstdint>
+#include <optional>
 #include <map>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "bbw/dds/run_id.hpp"
 
 namespace bbw::dds {
 
@@ -42,7 +49,13 @@ struct ParticipantOptions {
   std::string name;                     // participant name seen in discovery, e.g. "bbw_corner_FL"
   // Extra participant properties appended to the profile's (e.g. DDS Security plugins, issue 7).
   std::vector<std::pair<std::string, std::string>> properties;
+  // The run this participant belongs to (bbw/dds/run_id.hpp); announced in USER_DATA with the
+  // process id, so that a participant of another bbw run on the same domain is noticed.
+  std::uint64_t run_id = 0;
 };
+
+// A participant of another bbw run seen on this domain (its run id, pid and participant name).
+using ForeignRun = PeerTag;
 
 // env BBW_DDS_PROFILES if set, else the file in the source tree this binary was built from.
 std::string default_profiles_file();
@@ -51,10 +64,10 @@ std::string default_profiles_file();
 // Throws DdsError naming the file when it is missing or malformed.
 void load_profiles(const std::string& file);
 
-class Participant {
+class Participant : private eprosima::fastdds::dds::DomainParticipantListener {
  public:
   explicit Participant(const ParticipantOptions& options);
-  ~Participant();
+  ~Participant() override;
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;
 
@@ -67,6 +80,13 @@ class Participant {
   eprosima::fastdds::dds::Publisher& publisher(const std::string& partition);
   eprosima::fastdds::dds::Subscriber& subscriber(const std::string& partition);
   int domain_id() const { return domain_id_; }
+  std::uint64_t run_id() const { return run_id_; }
+  // Participants of other bbw runs discovered on this domain so far (one entry per process).
+  std::vector<ForeignRun> foreign_runs() const;
+  // The bbw tag a discovered participant announced, by its 12-byte GUID prefix (the first 12
+  // bytes of any of its writers' handles); nullopt when it announced none. Not authenticated
+  // without DDS Security: any participant can announce any tag.
+  std::optional<PeerTag> peer_tag(const std::array<std::uint8_t, 12>& guid_prefix) const;
 
   // The topic `name` of type PubSubT (registered on first use), owned by this participant.
   template <class PubSubT>
@@ -84,7 +104,14 @@ class Participant {
   eprosima::fastdds::dds::Topic& topic_impl(const std::string& name,
                                             eprosima::fastdds::dds::TypeSupport type);
 
+  void on_participant_discovery(eprosima::fastdds::dds::DomainParticipant* participant,
+                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override;
+
   int domain_id_;
+  std::uint64_t run_id_;
+  mutable std::mutex foreign_mutex_;
+  std::vector<ForeignRun> foreign_;
+  std::map<std::array<std::uint8_t, 12>, PeerTag> peers_;
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;

@@ -6,6 +6,11 @@
 // when a process dies. A file is stale only when we can take the exclusive lock ourselves
 // (nobody alive holds it) and it is older than `min_age` (so a process that is creating its
 // files right now is never disturbed). Files of live processes are never touched.
+//
+// Fast DDS 2.9 also leaves port segments and their semaphores (fastrtps_portN,
+// sem.fastrtps_portN_mutex) with no lock file beside them (issue 17: 8 of each after a killed
+// CCU). Such a file is stale when no process maps it (/proc/<pid>/maps of every process this
+// user may read: its own Fast DDS processes always) and it is older than `min_age`.
 #pragma once
 
 #include <chrono>

@@ -101,6 +101,11 @@ class CcuNode {
   CcuNode& operator=(const CcuNode&) = delete;
 
   void set_observer(CcuObserver* observer) { observer_ = observer; }
+  // The run this CCU belongs to (bbw_launch's run id; 0 in process): stamped on commands and
+  // calibration states; blocks and health of another run are dropped and counted.
+  void set_run_id(std::uint64_t run_id) { run_id_ = run_id; }
+  std::uint64_t run_id() const { return run_id_; }
+  std::uint64_t foreign_run_samples() const { return foreign_run_samples_; }
 
   // Inputs, per corner channel (the adapter knows which corner's partition it read from).
   void on_block(std::size_t channel, const msg::MeasurementBlock& block, transport::EndpointId writer, double arrival_s);
@@ -166,6 +171,8 @@ class CcuNode {
   std::vector<msg::CalibrationState> initial_;
   std::vector<DetectionRecord> detections_;
   std::uint64_t unknown_corner_blocks_ = 0;
+  std::uint64_t run_id_ = 0;
+  std::uint64_t foreign_run_samples_ = 0;  // blocks and health of another run, dropped unread
   CcuObserver* observer_ = nullptr;
 };
 

@@ -21,6 +21,7 @@
 #include "bbw/faults/link_faults.hpp"
 #include "bbw/faults/schedule.hpp"
 #include "bbw/common/corner.hpp"
+#include "bbw/corner/command_gate.hpp"
 #include "bbw/scenario/corner_sim.hpp"
 #include "bbw/scenario/scenario.hpp"
 
@@ -36,6 +37,9 @@ struct CornerNodeOptions {
   // first period at or after it, from a released plant, with sample seq 1).
   std::uint32_t incarnation = 0;
   double resume_at_s = 0.0;
+  // The run this corner belongs to (bbw_launch's run id; 0 in process): stamped on every block and
+  // health message; commands and calibration states of another run are refused.
+  std::uint64_t run_id = 0;
 };
 
 struct CornerStats {
@@ -87,8 +91,10 @@ class CornerNode {
   void set_observer(CornerObserver* observer) { observer_ = observer; }
 
   // Inputs. `arrival_s`: the corner's simulated time when the command arrived (used in realtime
-  // once started; lockstep commands belong to their period's start, cmd.time_s()).
-  void on_command(const msg::ClampCommand& command, double arrival_s);
+  // once started; lockstep commands belong to their period's start, cmd.time_s()). Every command
+  // for this corner passes the CommandGate first (run id, the pinned CCU writer, the caliper's
+  // rated force range and rate; issue 17): `source` says who sent it.
+  void on_command(const msg::ClampCommand& command, const corner::CommandSource& source, double arrival_s);
   void on_calibration(const msg::CalibrationState& state);
 
   // Starts at the CCU's first command for our first period (the start signal). Returns the first
@@ -107,6 +113,7 @@ class CornerNode {
   // Finishes the counters at the end of a run.
   void finish(std::uint64_t transport_write_failures, std::uint64_t command_deadlines_missed);
 
+  const corner::CommandGate& gate() const { return gate_; }
   bool have_command() const { return have_command_; }
   const msg::ClampCommand& latest_command() const { return latest_command_; }
   // Lockstep: the command for period k (the grant to simulate it) or a stop is held.
@@ -131,6 +138,7 @@ class CornerNode {
   std::uint64_t periods_;
   std::uint8_t my_id_;
 
+  corner::CommandGate gate_;
   faults::FaultInjector injector_;
   faults::LinkFaults link_;
   faults::CcuWatchdog watchdog_;

@@ -47,6 +47,7 @@ struct InProcessOptions {
   // Carry out the schedule's process faults (kill, restart) as described above, like the
   // processes with --process-faults. False: a schedule with process faults is refused.
   bool process_faults = false;
+  std::uint64_t run_id = 0;  // stamped on every message, as bbw_launch's run id over DDS
 };
 
 // A hostile channel on the in-memory link from a corner to the CCU: sees every measurement
@@ -118,6 +119,7 @@ class InProcessRun {
 
   const scenario::Scenario& scenario_;
   InProcessOptions options_;
+  transport::EndpointId ccu_command_endpoint_ = 0;
   CcuNode ccu_;
   transport::InMemoryTopic<msg::ClampCommand> commands_{"ClampCommand"};
   transport::InMemoryTopic<msg::CalibrationState> calibration_{"CalibrationState"};

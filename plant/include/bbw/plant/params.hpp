@@ -76,6 +76,9 @@ struct PlantParams {
   KeyFrictionParams key_friction;
   SensorParams sensors;
   int substeps = 10;                            // integration substeps per step() call
+  // The caliper's rated clamp-force range [0, rated]: the corner refuses to command more
+  // (issue 17, corner_unit/include/bbw/corner/command_gate.hpp).
+  double rated_clamp_force_kN = 40.0;
 
   void validate() const;  // throws std::invalid_argument
 };

@@ -1,0 +1,120 @@
+// The corner's command gate (issue 17): run id, pinned source, clamp-force range and rate.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "bbw/corner/command_gate.hpp"
+
+namespace {
+
+using bbw::corner::CommandGate;
+using bbw::corner::CommandGateParams;
+using bbw::corner::CommandSource;
+using bbw::corner::GateVerdict;
+
+constexpr std::uint64_t kRun = 0x1234abcdULL;
+
+CommandSource from(std::uint8_t writer, std::uint64_t run = kRun, bool announced_as_ccu = true) {
+  CommandSource s;
+  s.run_id = run;
+  s.writer.fill(writer);
+  s.announced_as_ccu = announced_as_ccu;
+  return s;
+}
+
+CommandGateParams params() {
+  CommandGateParams p;
+  p.max_force_kN = 40.0;
+  p.max_rate_kN_per_s = 8000.0;  // 40 kN per 5 ms
+  return p;
+}
+
+TEST(CommandGate, DefaultParamsAreValidAndBadOnesNameTheField) {
+  EXPECT_NO_THROW(CommandGateParams{}.validate());
+  CommandGateParams p;
+  p.max_force_kN = 0.0;
+  try {
+    p.validate();
+    FAIL() << "a zero force range was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("max_force_kN"), std::string::npos) << e.what();
+  }
+  p = CommandGateParams{};
+  p.max_rate_kN_per_s = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(CommandGate(kRun, p), std::invalid_argument);
+}
+
+TEST(CommandGate, RefusesAnotherRunsCommandEvenFirst) {
+  CommandGate gate(kRun, params());
+  const auto r = gate.check(from(1, kRun + 1), true, 10.0, 0.0);
+  EXPECT_EQ(r.verdict, GateVerdict::RefusedRun);
+  EXPECT_FALSE(r.applies());
+  EXPECT_FALSE(gate.pinned()) << "another run's command must not name the CCU";
+  EXPECT_EQ(gate.counts().refused_run, 1u);
+}
+
+TEST(CommandGate, TakesOnlyTheWriterOfTheFirstAcceptedCommand) {
+  CommandGate gate(kRun, params());
+  EXPECT_EQ(gate.check(from(1), true, 10.0, 0.000).verdict, GateVerdict::Accepted);
+  EXPECT_EQ(gate.check(from(2), true, 10.0, 0.005).verdict, GateVerdict::RefusedSource);
+  EXPECT_EQ(gate.check(from(2), false, 0.0, 0.005).verdict, GateVerdict::RefusedSource) << "a release from another writer";
+  EXPECT_EQ(gate.check(from(1), true, 12.0, 0.005).verdict, GateVerdict::Accepted);
+  EXPECT_EQ(gate.counts().accepted, 2u);
+  EXPECT_EQ(gate.counts().refused_source, 2u);
+  EXPECT_EQ(gate.counts().refused(), 2u);
+}
+
+TEST(CommandGate, PinsOnlyAWriterAnnouncedAsThisRunsCcu) {
+  CommandGate gate(kRun, params());
+  // An intruder that knows the run id but is not the CCU comes first: refused, nothing pinned.
+  EXPECT_EQ(gate.check(from(9, kRun, false), true, 77.7, 0.0).verdict, GateVerdict::RefusedSource);
+  EXPECT_FALSE(gate.pinned());
+  EXPECT_EQ(gate.check(from(1), true, 10.0, 0.0).verdict, GateVerdict::Accepted);
+  EXPECT_TRUE(gate.pinned());
+  EXPECT_EQ(gate.check(from(9, kRun, false), true, 77.7, 0.005).verdict, GateVerdict::RefusedSource);
+  EXPECT_EQ(gate.counts().refused_source, 2u);
+}
+
+TEST(CommandGate, ClampsForceToTheRatedRange) {
+  CommandGate gate(kRun, params());
+  auto r = gate.check(from(1), true, 77.7, 0.0);  // the intruder's force of issue 17
+  EXPECT_EQ(r.verdict, GateVerdict::Clamped);
+  EXPECT_DOUBLE_EQ(r.force_kN, 40.0);
+  r = gate.check(from(1), true, -5.0, 0.010);
+  EXPECT_EQ(r.verdict, GateVerdict::Clamped);
+  EXPECT_DOUBLE_EQ(r.force_kN, 0.0);
+  EXPECT_EQ(gate.counts().clamped, 2u);
+}
+
+TEST(CommandGate, LimitsTheRateOfChangeBetweenCommandPeriods) {
+  CommandGate gate(kRun, params());
+  EXPECT_DOUBLE_EQ(gate.check(from(1), true, 0.0, 0.0).force_kN, 0.0);
+  // Full range in one 5 ms period is allowed (a CCU step), faster is not.
+  EXPECT_DOUBLE_EQ(gate.check(from(1), true, 40.0, 0.005).force_kN, 40.0);
+  auto r = gate.check(from(1), true, 0.0, 0.006);  // 1 ms later: at most 8 kN down
+  EXPECT_EQ(r.verdict, GateVerdict::Clamped);
+  EXPECT_DOUBLE_EQ(r.force_kN, 32.0);
+  r = gate.check(from(1), true, 0.0, 0.006);  // no time passed: no change at all
+  EXPECT_DOUBLE_EQ(r.force_kN, 32.0);
+  r = gate.check(from(1), true, 40.0, 0.005);  // time going backwards counts as none
+  EXPECT_DOUBLE_EQ(r.force_kN, 32.0);
+}
+
+TEST(CommandGate, ReleaseRestartsTheRateFromZero) {
+  CommandGate gate(kRun, params());
+  gate.check(from(1), true, 40.0, 0.0);
+  EXPECT_EQ(gate.check(from(1), false, 0.0, 0.001).verdict, GateVerdict::Accepted);
+  EXPECT_DOUBLE_EQ(gate.check(from(1), true, 40.0, 0.002).force_kN, 8.0);
+}
+
+TEST(CommandGate, RefusesAForceThatIsNoNumber) {
+  CommandGate gate(kRun, params());
+  EXPECT_EQ(gate.check(from(1), true, std::nan(""), 0.0).verdict, GateVerdict::RefusedValue);
+  EXPECT_FALSE(gate.pinned());
+  EXPECT_EQ(gate.check(from(1), true, std::numeric_limits<double>::infinity(), 0.0).verdict, GateVerdict::RefusedValue);
+  EXPECT_EQ(gate.counts().refused_value, 2u);
+}
+
+}  // namespace

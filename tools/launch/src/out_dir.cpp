@@ -1,0 +1,47 @@
+#include "out_dir.hpp"
+
+#include <filesystem>
+#include <regex>
+#include <stdexcept>
+#include <system_error>
+
+namespace bbw::launch {
+
+namespace fs = std::filesystem;
+
+bool is_run_output_name(const std::string& name) {
+  static const std::regex own(
+      "summary\\.json|report\\.html|report\\.gp|timeline\\.csv|timeline\\.png|keys\\.(out|err)|"
+      "ccu\\.(out|err|stats)|ccu_periods\\.csv|ccu_(FL|FR|RL|RR)\\.csv|(loop|time)_(FL|FR|RL|RR)\\.png|"
+      "corner_(FL|FR|RL|RR)(\\.[0-9]+)?\\.(out|err|stats)|corner_(FL|FR|RL|RR)_periods\\.csv");
+  return std::regex_match(name, own);
+}
+
+OutDirResult prepare_out_dir(const std::string& dir) {
+  OutDirResult result;
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) {
+    if (!fs::create_directories(dir, ec) || ec) {
+      throw std::invalid_argument("cannot create output directory " + dir + (ec ? ": " + ec.message() : ""));
+    }
+    return result;
+  }
+  if (!fs::is_directory(dir, ec)) throw std::invalid_argument("output directory " + dir + " is not a directory");
+  std::vector<fs::path> own;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!e.is_regular_file(ec) || !is_run_output_name(name)) {
+      throw std::invalid_argument("output directory " + dir + " holds '" + name +
+                                  "', which bbw did not write; use an empty or new directory (nothing was removed)");
+    }
+    own.push_back(e.path());
+  }
+  if (ec) throw std::invalid_argument("cannot list output directory " + dir + ": " + ec.message());
+  for (const auto& p : own) {
+    if (!fs::remove(p, ec) || ec) throw std::invalid_argument("cannot remove older " + p.string() + ": " + ec.message());
+    result.removed.push_back(p.filename().string());
+  }
+  return result;
+}
+
+}  // namespace bbw::launch
