@@ -29,4 +29,6 @@ std::string path(const std::string& relative) {
   throw std::runtime_error("cannot find bbw's " + relative + " (tried " + tried + "; set BBW_DATA_DIR to the folder holding config/)");
 }
 
+std::string root() { return fs::path(path("config")).parent_path().string(); }
+
 }  // namespace bbw::data

@@ -18,9 +18,7 @@
 
 #include "bbw/dds/run_id.hpp"
 
-#ifndef BBW_DEFAULT_DDS_PROFILES
-#error "BBW_DEFAULT_DDS_PROFILES must be defined by dds/CMakeLists.txt"
-#endif
+#include "bbw/common/data_path.hpp"
 
 namespace bbw::dds {
 
@@ -28,7 +26,7 @@ namespace fdds = eprosima::fastdds::dds;
 
 std::string default_profiles_file() {
   if (const char* env = std::getenv("BBW_DDS_PROFILES"); env != nullptr && *env != '\0') return env;
-  return BBW_DEFAULT_DDS_PROFILES;
+  return bbw::data::path("config/dds/bbw_profiles.xml");
 }
 
 void load_profiles(const std::string& file) {

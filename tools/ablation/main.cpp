@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "bbw/common/data_path.hpp"
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/calibration/offline.hpp"
 #include "bbw/calibration/rig_recording.hpp"
@@ -32,7 +33,7 @@ std::vector<Recording> record_all(const bbw::scenario::Scenario& sc) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string config_file = BBW_DEFAULT_CALIBRATOR_CONFIG;
+  std::string config_file;  // default: config/calibrator/robust.yaml of bbw's data
   std::vector<std::string> scenarios;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -50,6 +51,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
+    if (config_file.empty()) config_file = bbw::data::path("config/calibrator/robust.yaml");
     const auto base = load_config(config_file);
     const std::vector<Variant> variants = {
         {"robust (all choices on)", [](CalibratorConfig&) {}},

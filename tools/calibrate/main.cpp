@@ -6,6 +6,7 @@
 #include <iostream>
 #include <string>
 
+#include "bbw/common/data_path.hpp"
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/calibration/offline.hpp"
 #include "bbw/common/csv.hpp"
@@ -24,7 +25,7 @@ const char* kUsage =
     "  Exit: 0 calibrated, 1 an error or no fit accepted (summary.json says why), 2 bad arguments.\n";
 
 struct Args {
-  std::string input, config = BBW_DEFAULT_CALIBRATOR_CONFIG, out;
+  std::string input, config, out;  // config default: config/calibrator/robust.yaml of bbw's data
   std::string time_col = "time_s", position_col = "position_rev", force_col = "force_internal_kN";
   std::string truth_col, speed_col, temperature_col;
   bool truth_given = false, speed_given = false, temperature_given = false;
@@ -90,6 +91,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
+    if (a.config.empty()) a.config = bbw::data::path("config/calibrator/robust.yaml");
     const auto config = bbw::calibration::load_config(a.config);
     bbw::csv::ReadOptions ro;
     ro.required = {a.time_col, a.position_col, a.force_col};

@@ -56,6 +56,7 @@
 #include "bbw/dds/shm_cleanup.hpp"
 #include "bbw/faults/link_faults.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
+#include "bbw/common/data_path.hpp"
 #include "bbw/launch/child.hpp"
 #include "bbw/launch/signals.hpp"
 #include "bbw/launch/stats_file.hpp"
@@ -118,7 +119,7 @@ int main(int argc, char** argv) {
   bool report = true;
   bool secure = false;
   bool allow_large = false;  // --allow-large: accept a run over the size limits (scenario/run_checks.hpp)
-  std::string keys_dir = std::string(BBW_REPO_DIR) + "/keys";
+  std::string keys_dir;  // default: keys/ in bbw's data root (bbw/common/data_path.hpp)
   int domain = 0;
   try {
     for (bbw::dds::ArgCursor args(argc, argv); !args.done();) {
@@ -194,6 +195,7 @@ int main(int argc, char** argv) {
   if (secure) {
     // Keys: created by scripts/bbw-keys.sh when any file is missing (idempotent), then checked.
     std::error_code ec;
+    if (keys_dir.empty()) keys_dir = bbw::data::root() + "/keys";
     keys_dir = std::filesystem::absolute(keys_dir, ec).lexically_normal().string();
     // One launcher at a time checks and creates the keys of a directory (two runs started at
     // once must not both write it): an flock on a lock file named after it, held until here ends.
@@ -222,7 +224,7 @@ int main(int argc, char** argv) {
     };
     if (!check_keys().empty()) {
       std::cout << "bbw_launch: creating DDS Security keys in " << keys_dir << std::endl;
-      Child keys("bbw-keys.sh", {std::string(BBW_REPO_DIR) + "/scripts/bbw-keys.sh", keys_dir},
+      Child keys("bbw-keys.sh", {bbw::data::path("scripts/bbw-keys.sh"), keys_dir},
                  out_dir + "/keys.out", out_dir + "/keys.err");
       const auto st = keys.wait_until(Clock::now() + 120s);
       if (!st || !st->ok()) {

@@ -14,5 +14,7 @@ namespace bbw::data {
 std::string executable_dir();
 // The data root (see above) that holds `relative`, joined with it.
 std::string path(const std::string& relative);
+// The data root itself: the folder that holds config/.
+std::string root();
 
 }  // namespace bbw::data
