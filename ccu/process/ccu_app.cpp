@@ -39,11 +39,9 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
       node_(scenario, calibrator, options.friction_feedback, options.monitor),
       periods_(node_.periods()),
       participant_(named(options.participant)),
-      // Commands and calibration state in the run's partition, measurements and health in each
-      // corner's partition of this run (bbw/dds/run_id.hpp): another run on the domain never matches.
-      commands_(participant_, dds::kCommandTopic,
-                dds::profiles_for(options.mode == ClockMode::Lockstep).command_writer, events,
-                dds::Partition{dds::run_partition(options.participant.run_id)}),
+      // Calibration state in the run's partition; measurements, health and each corner's commands
+      // in that corner's partition of this run (bbw/dds/run_id.hpp): another run on the domain
+      // never matches, and a corner is woken only by its own command (not by all four).
       calibration_(participant_, dds::kCalibrationTopic, "state_writer", events,
                    dds::Partition{dds::run_partition(options.participant.run_id)}) {
   node_.set_run_id(options.participant.run_id);
@@ -54,6 +52,9 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
         participant_, dds::kMeasurementTopic,
         dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_reader, events, partition));
     health_.push_back(std::make_unique<HealthInlet>(participant_, dds::kHealthTopic, "state_reader", events, partition));
+    commands_.push_back(std::make_unique<CommandOutlet>(
+        participant_, dds::kCommandTopic, dds::profiles_for(options.mode == ClockMode::Lockstep).command_writer, events,
+        partition));
   }
   instances_.resize(node_.channels());
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
@@ -76,6 +77,7 @@ CcuApp::~CcuApp() {
   // The readers go before the participant (members are destroyed after this body).
   blocks_.clear();
   health_.clear();
+  commands_.clear();
 }
 
 double CcuApp::realtime_now_s() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
@@ -91,7 +93,8 @@ bool CcuApp::wait_for_corners(std::string& error) {
   const int n = static_cast<int>(node_.channels());
   const bool ok = events_.wait_for(options_.discovery_timeout, [&] {
     drain_health();
-    bool all = commands_.peers() >= n && calibration_.peers() >= n;
+    bool all = calibration_.peers() >= n;
+    for (const auto& c : commands_) all = all && c->peers() >= 1;
     for (std::size_t i = 0; i < node_.channels(); ++i) all = all && node_.channel(i).health >= 0 && blocks_[i]->peers() >= 1;
     return all;
   });
@@ -110,7 +113,9 @@ bool CcuApp::wait_for_corners(std::string& error) {
 }
 
 void CcuApp::send_commands(std::uint64_t step, bool stop, bool log) {
-  for (const msg::ClampCommand& c : node_.commands(step, stop, log)) commands_.send(c);
+  // The node's commands are in channel order, as commands_.
+  const auto& cmds = node_.commands(step, stop, log);
+  for (std::size_t i = 0; i < cmds.size(); ++i) commands_[i]->send(cmds[i]);
 }
 
 void CcuApp::send_calibration_updates() {
@@ -261,7 +266,7 @@ int CcuApp::run(std::string& error) {
   wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
   sim_s_ = static_cast<double>(periods_done_) * T;
   send_commands(periods_, true);
-  commands_.get().get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
+  for (auto& c : commands_) c->get().get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
   if (log_ != nullptr) log_->flush();
   return rc;
 }
@@ -290,7 +295,9 @@ void CcuApp::write_stats(const std::string& file) const {
   w.set("unknown_corner_blocks", static_cast<unsigned long long>(node_.unknown_corner_blocks()));
   w.set("foreign_run_samples", static_cast<unsigned long long>(node_.foreign_run_samples()));
   w.set("foreign_runs", dds::join_peer_tags(participant_.foreign_runs()));
-  w.set("command_write_failures", static_cast<unsigned long long>(commands_.get().write_failures()));
+  std::uint64_t command_failures = 0;
+  for (const auto& c : commands_) command_failures += c->get().write_failures();
+  w.set("command_write_failures", static_cast<unsigned long long>(command_failures));
   std::string corners;
   for (std::size_t i = 0; i < node_.channels(); ++i) corners += (corners.empty() ? "" : ",") + std::string(corner_name(node_.channel(i).corner));
   w.set("corners", corners);

@@ -85,7 +85,8 @@ class CcuApp {
   std::vector<std::unique_ptr<BlockInlet>> blocks_;
   std::vector<std::unique_ptr<HealthInlet>> health_;
   std::vector<eprosima::fastrtps::rtps::InstanceHandle_t> instances_;  // each corner's key instance
-  dds::DdsOutlet<msg::ClampCommandPubSubType> commands_;
+  using CommandOutlet = dds::DdsOutlet<msg::ClampCommandPubSubType>;
+  std::vector<std::unique_ptr<CommandOutlet>> commands_;  // one per corner, in its partition
   dds::DdsOutlet<msg::CalibrationStatePubSubType> calibration_;
 
   msg::MeasurementBlock block_;

@@ -54,7 +54,7 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       participant_(named(options.participant, options.corner)),
       // Measurements and health in the corner's own partition of this run (corner_FL.run_<id>,
       // bbw/dds/run_id.hpp), secure or not: the permissions grant a corner only its own
-      // (docs/security.md). Commands and calibration state in the run's partition run_<id>.
+      // (docs/security.md). Its commands come in that partition too (the CCU writes each corner's there), calibration state in the run's partition run_<id>.
       blocks_(participant_, dds::kMeasurementTopic,
               dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_writer, events,
               dds::Partition{own_partition(options)}),
@@ -65,7 +65,7 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       // corners' samples instead (4 commands per period, a few bytes each).
       commands_(participant_, dds::kCommandTopic,
                 dds::profiles_for(options.mode == ClockMode::Lockstep).command_reader, events,
-                dds::Partition{dds::run_partition(options.participant.run_id)}),
+                dds::Partition{own_partition(options)}),
       calibration_(participant_, dds::kCalibrationTopic, "state_reader", events,
                    dds::Partition{dds::run_partition(options.participant.run_id)}) {
   if (!options.periods_log.empty()) {

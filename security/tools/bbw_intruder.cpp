@@ -42,6 +42,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "bbw/dds/domain.hpp"
 #include "bbw/dds/events.hpp"
@@ -242,7 +243,9 @@ int main(int argc, char** argv) {
   try {
     bbw::dds::Participant participant(participant_options(o));
     participant_ok = true;
-    std::unique_ptr<bbw::dds::Writer<CommandT>> writer;
+    // Commands: one writer per corner. With --run-id in each corner's partition of that run
+    // (where the CCU writes that corner's commands); without it partition-less.
+    std::vector<std::unique_ptr<bbw::dds::Writer<CommandT>>> writers;
     if (!o.measurements.empty()) {
       const std::string id = bbw::security::corner_identity(o.corner);  // validates the corner
       const int corner_id = id == "fl" ? 0 : id == "fr" ? 1 : id == "rl" ? 2 : 3;
@@ -268,14 +271,18 @@ int main(int argc, char** argv) {
         bw->get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
       }
     } else try {
-      writer = std::make_unique<bbw::dds::Writer<CommandT>>(
-          participant, bbw::dds::kCommandTopic, "command_writer_realtime", events,
-          bbw::dds::Partition{o.run_id ? bbw::dds::run_partition(*o.run_id) : std::string()});
+      for (int c = 0; c < 4; ++c) {
+        writers.push_back(std::make_unique<bbw::dds::Writer<CommandT>>(
+            participant, bbw::dds::kCommandTopic, "command_writer_realtime", events,
+            bbw::dds::Partition{o.run_id ? bbw::dds::corner_run_partition(bbw::security::corner_partition(c), *o.run_id)
+                                         : std::string()}));
+      }
       writer_ok = true;
     } catch (const bbw::dds::DdsError& e) {
       refused = e.what();
+      writers.clear();
     }
-    if (writer) {
+    if (!writers.empty()) {
       // One command per corner every 5 ms until the deadline; waits are timed condition waits.
       const auto start = std::chrono::steady_clock::now();
       const auto end = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -292,9 +299,11 @@ int main(int argc, char** argv) {
           cmd.clamp_force_kN(o.force_kN);
           cmd.mode(bbw::msg::MODE_FORCE);
           cmd.valid(true);
-          if (writer->write(cmd)) ++written;
+          if (writers[c]->write(cmd)) ++written;
         }
-        max_matched = std::max(max_matched, writer->matched());
+        int matched = 0;  // readers reached over all writers (one corner each with --run-id)
+        for (const auto& w : writers) matched += w->matched();
+        max_matched = std::max(max_matched, matched);
         tick += std::chrono::milliseconds(5);
         events.wait_until(std::min(tick, end), [] { return false; });
       }
