@@ -88,10 +88,10 @@ void print_distribution(const CalibratorConfig& c, const Set& set) {
     worst.push_back(res.stats.fits_accepted > 0 ? res.score.max_abs_error_kN : INFINITY);
     rms.push_back(res.score.rms_error_kN);
     if (worst.back() > worst[arg]) arg = k;
-    std::printf("%-70s worst %.3f kN  rms %.4f kN  fits %llu/%llu  first fit %.1f s\n", set.labels[k].c_str(),
+    std::printf("%-70s worst %.3f kN  rms %.4f kN  fits %llu/%llu  first fit %.1f s  max at %.2f s\n", set.labels[k].c_str(),
                 worst.back(), rms.back(), static_cast<unsigned long long>(res.stats.fits_accepted),
                 static_cast<unsigned long long>(res.stats.fits_accepted + res.stats.fits_rejected),
-                res.stats.first_fit_time_s);
+                res.stats.first_fit_time_s, res.score.time_of_max_error_s);
     std::fflush(stdout);
   }
   std::size_t over = 0;

@@ -109,10 +109,12 @@ class Calibrator {
   std::uint64_t samples_since_start_ = 0;
   double last_time_s_ = 0.0;
   bool have_time_ = false;
-  // Streaming element states are exact once x has moved Delta_max one way from the first
-  // sample (every element has then slipped); cycle starts before that are ignored.
-  double first_x_rev_ = 0.0;
+  // Streaming element states are exact once x has moved 2 Delta_max from its running lowest
+  // or highest position (every element has then slipped, whatever its initial deflection);
+  // cycle starts before that are ignored.
+  double low_x_rev_ = 0.0, high_x_rev_ = 0.0;
   bool states_known_ = false;
+  std::vector<char> identified_;  // per phi: identified by at least one accepted fit
 
   std::vector<double> element_pos_rev_;  // live element positions x_i
   std::vector<double> n_now_;            // live n_i, then the extra regressors
