@@ -317,9 +317,12 @@ bool Calibrator::end_cycle() {
     const double phi_new = (robust_ || !element) ? theta_[a] : theta_[a] * friction_.delta_rev[i];
     // Smoothing starts with an element's second identification: the first replaces the
     // zero it started from (a wide friction's large elements are identified cycles later).
-    const double w = (robust_ && identified_[i]) ? config_.k_smoothing : 1.0;
+    // Running mean over an element's first identifications, then the exponential smoothing.
+    const double w = (robust_ && identified_[i]) ? std::max(config_.k_smoothing, 1.0 / (1.0 + identified_[i])) : 1.0;
     phi_kN_[i] = (1.0 - w) * phi_kN_[i] + w * phi_new;
-    if (!element || !robust_ || !config_.identify_per_element || span >= 2.0 * friction_.delta_rev[i]) identified_[i] = 1;
+    if (!element || !robust_ || !config_.identify_per_element || span >= 2.0 * friction_.delta_rev[i]) {
+      if (identified_[i] < 100) ++identified_[i];
+    }
     if (element) friction_.stiffness_kN_per_rev[i] = phi_kN_[i] / friction_.delta_rev[i];
     else friction_.viscous_kN_per_rev_per_s = phi_kN_[i] / config_.viscous_speed_scale_rev_per_s;
   }
