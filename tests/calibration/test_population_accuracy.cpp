@@ -33,7 +33,8 @@ TEST(CalibratorPopulation, ScoringPopulationEveryRecordingWithinPaperBound) {
     for (std::size_t i = 0; i < sc.corners.size(); ++i) {
       const auto rec = record_corner(sc, i);
       const auto r = run_recording(robust, rec);
-      std::string name = "c" + std::to_string(m);
+      std::string name = "c";
+      name += std::to_string(m);
       name += "_";
       name += sc.corners[i].name;
       name += " (";

@@ -124,6 +124,7 @@ Calibrator::Calibrator(const CalibratorConfig& config)
     vel_x_rev_.assign(static_cast<std::size_t>(config.velocity_window), 0.0);
   }
   start_pos_rev_.assign(m, 0.0);
+  residual_kN_.assign(static_cast<std::size_t>(robust_ ? config.residual_window : 1), 0.0);
   gram_.assign(p * p, 0.0);
   rhs_.assign(p, 0.0);
   theta_.assign(p, 0.0);
@@ -142,7 +143,7 @@ std::size_t Calibrator::state_bytes() const {
          vb(pf_x_rev_) + vb(pf_f_kN_) + vb(pf_proj_) + (store_.bytes() - sizeof(store_)) +
          (solver_.bytes() - sizeof(solver_)) + vb(element_pos_rev_) + vb(n_now_) + vb(vel_t_s_) + vb(vel_x_rev_) + 2 * position_delay_.capacity() * sizeof(double) + vb(start_pos_rev_) +
          vb(gram_) + vb(rhs_) + vb(theta_) + vb(row_) + vb(full_row_) + vb(n_replay_) + vb(pos_replay_) + vb(column_on_) +
-         vb(column_map_) + vb(nonneg_flags_) + vb(identified_) + static_cast<std::size_t>(2 * config_.start_lag_n0 + 1) * sizeof(double);
+         vb(column_map_) + vb(nonneg_flags_) + vb(identified_) + vb(residual_kN_) + static_cast<std::size_t>(2 * config_.start_lag_n0 + 1) * sizeof(double);
 }
 
 void Calibrator::reset_curve(const Curve& curve) {
@@ -455,7 +456,10 @@ Estimate Calibrator::update(const Sample& s) {
   for (int i = 0; i < m_ + e_; ++i) f_fric += phi_kN_[static_cast<std::size_t>(i)] * n_now_[static_cast<std::size_t>(i)];
 
   if (in_cycle_) {
-    store_.add(x, f_c, n_now_.data());
+    // Robust mode fits only samples inside the curve's range [x_min, x_max]: below it the pads
+    // open and the cubic cannot follow the contact kink, and the large elements' partial
+    // ramps would absorb that misfit as friction. The element states still run everywhere.
+    if (!robust_ || (x >= config_.x_min_rev && x <= config_.x_max_rev)) store_.add(x, f_c, n_now_.data());
     ++samples_since_start_;
   }
 
@@ -464,6 +468,18 @@ Estimate Calibrator::update(const Sample& s) {
   e.curve_force_kN = curve_.force_kN(x_now);
   e.force_kN = f_c - f_fric;
   if (delayed) e.force_kN += e.curve_force_kN - curve_.force_kN(x);
+  if (residual_kN_.size() > 1) {
+    // f_hat = C(x_now) + mean of the last residuals; a new curve restarts the mean (the stored
+    // residuals were taken against the old one).
+    if (e.fit_accepted) residual_count_ = 0;
+    const std::size_t w = residual_kN_.size();
+    residual_head_ = (residual_head_ + 1) % w;
+    residual_kN_[residual_head_] = e.force_kN - e.curve_force_kN;
+    if (residual_count_ < w) ++residual_count_;
+    double sum = 0.0;
+    for (std::size_t k = 0; k < residual_count_; ++k) sum += residual_kN_[(residual_head_ + w - k) % w];
+    e.force_kN = e.curve_force_kN + sum / static_cast<double>(residual_count_);
+  }
   e.calibrated = stats_.fits_accepted > 0;
   return e;
 }

@@ -129,6 +129,9 @@ class Calibrator {
   // Load-cell thermal offset: the last finite temperature (the reference until one arrives).
   double temperature_C_ = 0.0;
   std::vector<double> start_pos_rev_;    // x0_i at the current cycle's start (replay)
+  // Residual averaging (config residual_window): ring of the last residuals f_c - friction - C(x).
+  std::vector<double> residual_kN_;
+  std::size_t residual_head_ = 0, residual_count_ = 0;
 
   // Fit workspace, sized at construction.
   BoundedLeastSquares solver_;

@@ -51,6 +51,12 @@ struct CalibratorConfig {
   double start_margin_rev = 0.02;    // robust start detector hysteresis (0 = the paper's eq. 6)
   double k_smoothing = 1.0;          // weight of a new fit's friction stiffness (1 = replace)
   bool identify_per_element = true;  // update K_i only when the cycle span >= 2 Delta_i
+  // Load-cell noise passes straight into f_hat = f_c - friction. The estimate is the curve at
+  // the present position plus the mean of the last residual_window residuals
+  // r = f_c - friction - C(x) (the curve error and friction misfit vary slowly; the noise is
+  // white), so the noise falls by sqrt(window). 1 = off; at most kMaxResidualWindow samples.
+  int residual_window = 1;
+  static constexpr int kMaxResidualWindow = 64;
 
   // Optional model terms for effects found offline (./bbw analyze), per caliper.
   // viscous_friction: a load-cell term c_v * v (v = resolver speed, or the slope of the last
