@@ -140,6 +140,17 @@ int main(int argc, char** argv) {
     const auto base = load_config(config_file);
     const std::vector<Variant> variants = {
         {"robust (all choices on)", [](CalibratorConfig&) {}},
+        {"no residual averaging (residual_window 1)", [](CalibratorConfig& c) { c.residual_window = 1; }},
+        {"8 elements over the same span (ratio 0.45)", [](CalibratorConfig& c) { c.elements_M = 8; c.geometric_ratio = 0.45; }},
+        {"L = 64 samples per cycle", [](CalibratorConfig& c) { c.samples_L = 64; }},
+        {"previous settings, current code: M = 8, L = 64, Delta_max 0.4, ratio 0.6, window 1",
+         [](CalibratorConfig& c) {
+           c.elements_M = 8;
+           c.samples_L = 64;
+           c.delta_max_rev = 0.4;
+           c.geometric_ratio = 0.6;
+           c.residual_window = 1;
+         }},
         {"x not scaled to [-1, 1]", [](CalibratorConfig& c) { c.scale_x = false; }},
         {"K_i unconstrained (no NNLS)", [](CalibratorConfig& c) { c.nonnegative_k = false; }},
         {"every K_i and the curve updated from any span", [](CalibratorConfig& c) { c.identify_per_element = false; c.min_cycle_span_rev = 0.0; }},
