@@ -12,6 +12,7 @@
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/plant/params_yaml.hpp"
 #include "bbw/scenario/load.hpp"
+#include "bbw/scenario/population.hpp"
 
 namespace fs = std::filesystem;
 
@@ -25,6 +26,7 @@ TEST(EveryConfig, EachYamlFileLoadsWithItsFoldersLoader) {
       {"scenarios/faults", [](const std::string& f) { bbw::faults::load_fault_scenario(f); }},
       {"calibrator", [](const std::string& f) { bbw::calibration::load_config(f); }},
       {"analysis", [](const std::string& f) { bbw::analyze::load_options_file(f); }},
+      {"population", [](const std::string& f) { bbw::scenario::load_population_spec(f); }},
   };
   int loaded = 0;
   for (const auto& entry : fs::recursive_directory_iterator(root)) {
