@@ -182,7 +182,9 @@ Evaluated evaluate(const Context& c, const Spec& s, Design d, const Eigen::Vecto
   std::vector<Index> all(c.n);
   std::iota(all.begin(), all.end(), Index{0});
   e.rms_residual = rms_of(ev.residual, all);
-  e.max_residual = ev.residual.cwiseAbs().maxCoeff();
+  const std::size_t first = std::min(calibration::first_known_sample(d.x_eff.data(), c.n, s.delta_max), c.n - 1);
+  e.unscored_initial_samples = first;
+  e.max_residual = ev.residual.tail(static_cast<Index>(c.n - first)).cwiseAbs().maxCoeff();
   e.holdout_rms_residual = rms_of(ev.residual, c.holdout);
   if (!c.rec.truth.empty()) {
     e.has_truth = true;
@@ -208,10 +210,11 @@ Evaluated evaluate(const Context& c, const Spec& s, Design d, const Eigen::Vecto
     for (std::size_t k = 0; k < c.n; ++k) {
       const double err = c.rec.force[k] - sensor(static_cast<Index>(k)) - truth[k];
       ev.truth_error[k] = err;
+      if (k < first) continue;
       ss += err * err;
       mx = std::max(mx, std::abs(err));
     }
-    e.rms_truth_error = std::sqrt(ss / static_cast<double>(c.n));
+    e.rms_truth_error = std::sqrt(ss / static_cast<double>(c.n - first));
     e.max_truth_error = mx;
   }
   ev.design = std::move(d);

@@ -95,6 +95,7 @@ Calibrator::Calibrator(const CalibratorConfig& config)
       detector_(config.start_lag_n0, robust_ ? config.start_margin_rev : 0.0),
       store_(config.samples_L, config.elements_M + (config.viscous_friction ? 1 : 0), config.x_max_rev - config.x_min_rev,
              config.f_max_kN - config.f_min_kN, config.drop_rule),
+      states_known_rule_(config.delta_max_rev),
       position_delay_(config.force_delay_s > 0.0 ? CalibratorConfig::kForceDelayCapacity : 2),
       solver_(kCurveTerms + config.elements_M + (config.viscous_friction ? 1 : 0)) {
   const auto m = static_cast<std::size_t>(m_);
@@ -409,20 +410,12 @@ Estimate Calibrator::update(const Sample& s) {
     x_now = delayed ? play_step(pulled, s.position_rev, config_.backlash_width_rev) : x;
   }
   if (!have_time_) {
-    low_x_rev_ = high_x_rev_ = x;
     for (auto& p : element_pos_rev_) p = x;
   }
   last_time_s_ = s.time_s;
   have_time_ = true;
-  if (!states_known_) {
-    // The recording may start with the friction deflected either way: every element's state
-    // is known once x has moved 2 Delta_max from its running extreme (then each element, the
-    // real one and the model's, has been dragged to x -/+ Delta_i whatever it started at).
-    low_x_rev_ = std::min(low_x_rev_, x);
-    high_x_rev_ = std::max(high_x_rev_, x);
-    states_known_ = !streaming_ || x - low_x_rev_ >= 2.0 * config_.delta_max_rev ||
-                    high_x_rev_ - x >= 2.0 * config_.delta_max_rev;
-  }
+  // The recording may start with the friction deflected either way (StatesKnown).
+  if (!states_known_) states_known_ = !streaming_ || states_known_rule_.update(x);
 
   const bool start = detector_.update(x) && states_known_;
   if (start && (!in_cycle_ || samples_since_start_ >= static_cast<std::uint64_t>(config_.samples_L))) {

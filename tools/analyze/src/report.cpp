@@ -21,6 +21,7 @@ void errors_json(json::Writer& w, const std::string& key, const analysis::ErrorF
   w.value("rms_residual", e.rms_residual);
   w.value("max_residual", e.max_residual);
   w.value("holdout_rms_residual", e.holdout_rms_residual);
+  w.value("unscored_initial_samples", e.unscored_initial_samples);  // left out of the max figures
   if (e.has_truth) {
     w.value("rms_truth_error", e.rms_truth_error);
     w.value("max_truth_error", e.max_truth_error);
@@ -244,6 +245,10 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
   };
   row("baseline", r.baseline);
   for (const auto& s : r.steps) row("+ " + s.evidence.name, s.errors);
+  md << "\nMax figures leave out the " << r.final_errors.unscored_initial_samples
+     << " samples before the position had travelled 2 Delta_max from its running extreme (the "
+        "friction's initial state is unknown until then; baseline: "
+     << r.baseline.unscored_initial_samples << ").\n";
   row("final", r.final_errors);
   md << "\nAll figures in " << u << ".\n\n## Steps\n\n";
   if (r.steps.empty()) md << "No candidate met the acceptance rule.\n";

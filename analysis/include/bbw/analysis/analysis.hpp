@@ -35,6 +35,11 @@ struct ErrorFigures {
   bool has_truth = false;
   double rms_truth_error = 0.0;  // clamp-force estimate minus truth
   double max_truth_error = 0.0;
+  // The recording may start with the friction deflected; the model's elements start relaxed.
+  // Samples before the position has travelled 2 Delta_max from its running extreme
+  // (calibration::StatesKnown, the online calibrator's rule) are not scored: the truth figures
+  // and max_residual leave them out, and this counts them.
+  std::size_t unscored_initial_samples = 0;
 };
 
 struct Parameter {

@@ -12,6 +12,7 @@
 #include "bbw/calibration/config.hpp"
 #include "bbw/common/delay_line.hpp"
 #include "bbw/calibration/curve.hpp"
+#include "bbw/calibration/maxwell_slip.hpp"
 #include "bbw/calibration/cycle_detector.hpp"
 #include "bbw/calibration/sample_store.hpp"
 
@@ -112,7 +113,7 @@ class Calibrator {
   // Streaming element states are exact once x has moved 2 Delta_max from its running lowest
   // or highest position (every element has then slipped, whatever its initial deflection);
   // cycle starts before that are ignored.
-  double low_x_rev_ = 0.0, high_x_rev_ = 0.0;
+  StatesKnown states_known_rule_;
   bool states_known_ = false;
   std::vector<char> identified_;  // per phi: identified by at least one accepted fit
 
