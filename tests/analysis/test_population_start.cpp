@@ -76,3 +76,32 @@ TEST(AnalyzePopulation, SaturatedInitialFrictionDoesNotDominateTheMaxFigures) {
   EXPECT_LT(saturated.baseline.max_truth_error, relaxed.baseline.max_truth_error + 0.15);
   EXPECT_LT(saturated.final_errors.max_truth_error, relaxed.final_errors.max_truth_error + 0.15);
 }
+
+TEST(AnalyzeOutliers, OneGrossPositionOutlierIsRejectedAndCreatesNoEffect) {
+  const auto spec = scenario::load_population_spec(source_dir() + "/config/population/scoring.yaml");
+  auto sc = scenario::population_scenario(spec, 1);
+  sc.corners.resize(1);
+  auto rec = record(sc);
+  // A recorded channel the analysis could blame for the spike, as in the file.
+  rec.channels.push_back({"command", rec.position});
+  const auto clean = analysis::analyze(rec, analysis::AnalysisOptions{});
+  auto bad = rec;
+  bad.position[12345] = 1e10;
+  const auto r = analysis::analyze(bad, analysis::AnalysisOptions{});
+  std::printf("clean: %zu steps, RMS residual %.4f kN; with the outlier: %zu steps, RMS residual %.4f kN, %zu outlier(s) %s\n",
+              clean.steps.size(), clean.final_errors.rms_residual, r.steps.size(), r.final_errors.rms_residual,
+              r.gross_outliers, r.gross_outlier_samples.empty() ? "" : r.gross_outlier_samples.front().c_str());
+  EXPECT_EQ(clean.gross_outliers, 0u);
+  EXPECT_EQ(r.gross_outliers, 1u);
+  ASSERT_EQ(r.gross_outlier_samples.size(), 1u);
+  EXPECT_EQ(r.gross_outlier_samples[0], "position@12345");
+  EXPECT_EQ(r.steps.size(), clean.steps.size());
+  for (std::size_t i = 0; i < std::min(r.steps.size(), clean.steps.size()); ++i) {
+    EXPECT_EQ(r.steps[i].evidence.name, clean.steps[i].evidence.name);
+  }
+  EXPECT_NEAR(r.final_errors.rms_residual, clean.final_errors.rms_residual, 0.002);
+  // The rule itself: a reading inside the bulk's range is never touched.
+  analysis::Recording mild = rec;
+  mild.position[100] = *std::max_element(rec.position.begin(), rec.position.end());
+  EXPECT_EQ(analysis::reject_gross_outliers(mild), 0u);
+}

@@ -77,6 +77,10 @@ std::string analysis_json(const LoadedRecording& in, const analysis::AnalysisOpt
   w.value("samples", r.samples);
   w.value("dt_s", r.dt_s);
   w.value("holdout_samples", r.holdout_samples);
+  w.value("gross_outliers", r.gross_outliers);  // replaced by the previous good value, not fitted
+  w.begin_array("gross_outlier_samples");
+  for (const auto& g : r.gross_outlier_samples) w.value("", g);
+  w.end_array();
   w.end_object();
   w.value("force_unit", in.force_unit);
   w.value("position_unit", in.position_unit);
@@ -245,6 +249,12 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
   };
   row("baseline", r.baseline);
   for (const auto& s : r.steps) row("+ " + s.evidence.name, s.errors);
+  if (r.gross_outliers > 0) {
+    md << "\n" << r.gross_outliers << " gross outlier(s) (more than 10 times the 0.5-99.5 % span outside it) "
+       << "replaced by the previous good value before fitting; first:";
+    for (const auto& g : r.gross_outlier_samples) md << " " << g;
+    md << ".\n";
+  }
   md << "\nMax figures leave out the " << r.final_errors.unscored_initial_samples
      << " samples before the position had travelled 2 Delta_max from its running extreme (the "
         "friction's initial state is unknown until then; baseline: "

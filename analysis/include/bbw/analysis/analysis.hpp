@@ -83,6 +83,12 @@ struct AnalysisResult {
   std::size_t samples = 0;
   double dt_s = 0.0;
   std::size_t holdout_samples = 0;
+  // Gross outliers (a reading far outside its channel's bulk, e.g. one position of 1e10):
+  // replaced by the channel's previous good value before anything is fitted, and counted.
+  // A value counts as gross when it lies more than 10 times the 0.5-99.5 % percentile span
+  // outside that span. Names: "position@1234".
+  std::size_t gross_outliers = 0;
+  std::vector<std::string> gross_outlier_samples;  // the first 10
   std::string differentiator;  // how velocity and acceleration were obtained
 
   int curve_knots = 0;  // 0: the eq. 5 cubic; else interior knots of the cubic spline
@@ -106,6 +112,11 @@ struct AnalysisResult {
   std::vector<double> display_regressor;
   std::vector<double> velocity;
 };
+
+// Replaces gross outliers in position, force, truth, temperature, velocity, acceleration and the
+// channels (rule above) by the previous good value of the same channel; returns how many, with
+// the first 10 named in `where` when given.
+std::size_t reject_gross_outliers(Recording& rec, std::vector<std::string>* where = nullptr);
 
 // Runs the whole analysis. Throws std::invalid_argument for an unusable recording (too short,
 // mismatched lengths, non-uniform or non-increasing time, constant position).
