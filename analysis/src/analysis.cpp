@@ -385,6 +385,10 @@ struct Scored {
   Spec spec;
 };
 
+// "" when the candidate's own fitted parameters are physical, else which one is not.
+std::string physical_bounds_violation(const Context& c, const Spec& s, const Design& d, const Eigen::VectorXd& b,
+                                      const std::string& name);
+
 Scored score_candidate(const Context& c, const Spec& s, const Candidate& cand, const Eigen::VectorXd& current_residual,
                        double current_holdout_rms) {
   Scored out;
@@ -422,6 +426,8 @@ Scored score_candidate(const Context& c, const Spec& s, const Candidate& cand, c
   out.score.t_statistic = paired_t(current_residual, r, c.holdout, c.opt.significance_blocks);
   out.score.significant =
       out.score.relative_drop >= c.opt.min_relative_drop && out.score.t_statistic >= c.opt.min_t_statistic;
+  out.score.rejected_reason = physical_bounds_violation(c, out.spec, d, b, cand.name);
+  if (!out.score.rejected_reason.empty()) out.score.significant = false;
   return out;
 }
 
@@ -488,6 +494,31 @@ std::vector<Parameter> effect_parameters(const std::vector<Parameter>& all, cons
   for (const auto& p : all)
     if (p.name.rfind(name + ".", 0) == 0) out.push_back(p);
   return out;
+}
+
+std::string physical_bounds_violation(const Context& c, const Spec& s, const Design& d, const Eigen::VectorXd& b,
+                                      const std::string& name) {
+  Evaluated ev;
+  ev.design = d;
+  ev.coef = b;
+  auto ends_with = [](const std::string& a, const std::string& tail) {
+    return a.size() >= tail.size() && a.compare(a.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  for (const auto& p : effect_parameters(model_parameters(c, s, ev), name)) {
+    std::string rule;
+    if (ends_with(p.name, ".unrelaxed_fraction") && !(p.value >= 0.0 && p.value < 1.0)) rule = "must be in [0, 1)";
+    if ((ends_with(p.name, ".mass") || ends_with(p.name, ".delay_s") || ends_with(p.name, ".width") ||
+         (name == "viscous_friction" && ends_with(p.name, ".coefficient"))) &&
+        !(p.value >= 0.0)) {
+      rule = "must be >= 0";
+    }
+    if (!rule.empty()) {
+      std::ostringstream o;
+      o << p.name << " = " << p.value << " " << rule;
+      return o.str();
+    }
+  }
+  return "";
 }
 
 Vec display_signal(const Context& c, const Spec& s, const std::string& name) {
@@ -677,6 +708,7 @@ AnalysisResult analyze(const Recording& raw, const AnalysisOptions& opt) {
   res.residual_before.assign(cur.residual.data(), cur.residual.data() + cur.residual.size());
   res.truth_error_before = cur.truth_error;
 
+  std::vector<CandidateScore> earlier_bounds;  // earlier rounds' candidates refused for their bounds
   for (int round = 0; round <= opt.max_steps; ++round) {
     const auto cands = candidates_for(c, spec);
     if (cands.empty()) break;
@@ -688,6 +720,7 @@ AnalysisResult analyze(const Recording& raw, const AnalysisOptions& opt) {
     std::vector<CandidateScore> scores;
     for (const auto& s : scored) scores.push_back(s.score);
     res.rounds.push_back(scores);
+
     // The best significant candidate by held-out RMS.
     const Scored* best = nullptr;
     for (const auto& s : scored)
@@ -700,6 +733,8 @@ AnalysisResult analyze(const Recording& raw, const AnalysisOptions& opt) {
       if (best) res.structure_notes.push_back("max_steps reached with a significant candidate left");
       break;
     }
+    for (const auto& s : scored)
+      if (!s.score.rejected_reason.empty()) earlier_bounds.push_back(s.score);
     Step st;
     st.evidence = best->score;
     for (const auto& s : scored)
@@ -732,6 +767,7 @@ AnalysisResult analyze(const Recording& raw, const AnalysisOptions& opt) {
     }
     res.steps.push_back(st);
   }
+  res.rejected.insert(res.rejected.end(), earlier_bounds.begin(), earlier_bounds.end());
   res.final_parameters = model_parameters(c, spec, cur);
   res.final_errors = cur.errors;
   res.residual_after.assign(cur.residual.data(), cur.residual.data() + cur.residual.size());

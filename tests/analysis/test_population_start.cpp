@@ -105,3 +105,37 @@ TEST(AnalyzeOutliers, OneGrossPositionOutlierIsRejectedAndCreatesNoEffect) {
   mild.position[100] = *std::max_element(rec.position.begin(), rec.position.end());
   EXPECT_EQ(analysis::reject_gross_outliers(mild), 0u);
 }
+
+TEST(AnalyzeBounds, UnphysicalCreepIsRejectedWithItsReason) {
+  // A load cell that overshoots and relaxes upwards: the plant's creep with its sign flipped.
+  // Creep would fit it best with a negative unrelaxed fraction, which no pad can have.
+  const auto spec = scenario::load_population_spec(source_dir() + "/config/population/scoring.yaml");
+  auto sc = scenario::population_scenario(spec, 2);
+  sc.corners.resize(1);
+  sc.corners[0].effects.creep.enabled = true;
+  sc.corners[0].effects.creep.relaxation_fraction = 0.1;
+  sc.corners[0].effects.creep.time_constant_s = 1.0;
+  scenario::CornerSim sim(sc, 0);
+  analysis::Recording rec;
+  const auto steps = static_cast<std::size_t>(std::llround(sc.duration_s / sc.plant_dt_s));
+  for (std::size_t k = 0; k < steps; ++k) {
+    const auto& s = sim.step(sc.plant_dt_s);
+    rec.time_s.push_back(s.time_s);
+    rec.position.push_back(s.position_rev);
+    rec.force.push_back(s.force_internal_kN - 2.0 * sim.plant().state().creep_kN);
+  }
+  const auto r = analysis::analyze(rec, analysis::AnalysisOptions{});
+  for (const auto& st : r.steps) {
+    EXPECT_NE(st.evidence.name, "creep") << "creep accepted with an unphysical fraction";
+  }
+  bool listed = false;
+  for (const auto& c : r.rejected) {
+    if (c.name == "creep") {
+      listed = true;
+      std::printf("creep rejected: %s (held-out drop %.1f %%)\n", c.rejected_reason.c_str(), 100.0 * c.relative_drop);
+      EXPECT_NE(c.rejected_reason.find("creep.unrelaxed_fraction"), std::string::npos) << c.rejected_reason;
+      EXPECT_NE(c.rejected_reason.find("must be in [0, 1)"), std::string::npos) << c.rejected_reason;
+    }
+  }
+  EXPECT_TRUE(listed) << "creep not in `rejected`";
+}

@@ -48,6 +48,7 @@ void score_json(json::Writer& w, const analysis::CandidateScore& s) {
   w.value("relative_drop", s.relative_drop);
   w.value("t_statistic", s.t_statistic);
   w.value("significant", s.significant);
+  if (!s.rejected_reason.empty()) w.value("rejected_reason", s.rejected_reason);
 }
 
 std::string fmt(double v, int prec = 4) {
@@ -282,11 +283,13 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
     }
     md << "```\n";
   }
-  md << "\n## Rejected (last round)\n\n| candidate | held-out RMS | drop | t |\n|---|---|---|---|\n";
+  md << "\n## Rejected (last round, and earlier candidates outside physical bounds)\n\n"
+        "| candidate | held-out RMS | drop | t | reason |\n|---|---|---|---|---|\n";
   for (const auto& s : r.rejected)
     md << "| " << s.name << (s.hyper_name.empty() ? "" : " (" + s.hyper_name + " = " + fmt(s.hyper_value) + ")")
        << " | " << fmt(s.holdout_rms) << " | " << fmt(100.0 * s.relative_drop, 3) << " % | "
-       << fmt(s.t_statistic, 3) << " |\n";
+       << fmt(s.t_statistic, 3) << " | " << (s.rejected_reason.empty() ? "not significant" : s.rejected_reason)
+       << " |\n";
   md << "\n## Structure left in the final residual\n\n";
   md << (r.unexplained_structure ? "**Structure is left that no candidate explains.**\n\n"
                                  : "No structure above the thresholds is left.\n\n");

@@ -57,6 +57,10 @@ struct CandidateScore {
   double relative_drop = 0.0;   // 1 - holdout_rms / current holdout rms
   double t_statistic = 0.0;     // paired held-out improvement, block means
   bool significant = false;
+  // Why the candidate cannot be accepted whatever its scores: a fitted parameter outside its
+  // physical bounds (masses, viscous coefficients, delays >= 0; creep's unrelaxed fraction in
+  // [0, 1)). Empty when within bounds.
+  std::string rejected_reason;
 };
 
 struct Step {
@@ -99,7 +103,9 @@ struct AnalysisResult {
   std::vector<Parameter> final_parameters;  // every term of the final model
   ErrorFigures final_errors;
   std::vector<std::vector<CandidateScore>> rounds;  // every round's scores, best first
-  std::vector<CandidateScore> rejected;             // the last round (none was accepted)
+  // The last round (none was accepted), then every candidate of earlier rounds refused for a
+  // parameter outside its physical bounds (rejected_reason says which).
+  std::vector<CandidateScore> rejected;
 
   std::vector<StructureFinding> structure;
   bool unexplained_structure = false;
