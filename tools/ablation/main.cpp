@@ -59,8 +59,14 @@ Set record_population(const std::string& file, int first, int count) {
   for (int m = first; m < first + count; ++m) {
     const auto sc = bbw::scenario::population_scenario(spec, m);
     for (std::size_t i = 0; i < sc.corners.size(); ++i) {
-      out.labels.push_back("c" + std::to_string(m) + "_" + sc.corners[i].name + " (" +
-                           bbw::plant::describe_key_friction(sc.plant.key_friction) + ")");
+      std::string label = "c";
+      label += std::to_string(m);
+      label += "_";
+      label += sc.corners[i].name;
+      label += " (";
+      label += bbw::plant::describe_key_friction(sc.plant.key_friction);
+      label += ")";
+      out.labels.push_back(label);
       out.recs.push_back(record_corner(sc, i));
       const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       const auto done = static_cast<double>(out.recs.size());
