@@ -489,6 +489,33 @@ std::vector<Parameter> model_parameters(const Context& c, const Spec& s, const E
   return out;
 }
 
+// Offset-versus-shift split of a temperature_drift step: the correlation of the two fitted
+// coefficients and the offset's standard error, from sigma^2 (X'X)^-1 over the fit rows.
+void split_uncertainty(const Context& c, const Spec& s, const Evaluated& ev, Step& st) {
+  const Design& d = ev.design;
+  Index offset_col = -1;
+  for (Index j = 0; j < d.x.cols(); ++j) {
+    const int o = d.owner[static_cast<std::size_t>(j)];
+    if (o >= 0 && s.columns[static_cast<std::size_t>(o)].kind == EffectKind::TemperatureDrift) {
+      offset_col = j;
+      break;
+    }
+  }
+  if (offset_col < 0 || offset_col + 2 >= d.x.cols()) return;
+  const Index shift_col = offset_col + 2;  // columns: offset, gain, shift
+  const LsqProblem p = normal_equations(d.x, c.y, c.train);
+  const Eigen::VectorXd scale = p.gram.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd g = scale.asDiagonal() * p.gram * scale.asDiagonal();
+  const Eigen::MatrixXd inv = g.ldlt().solve(Eigen::MatrixXd::Identity(g.rows(), g.cols()));
+  const double corr = inv(offset_col, shift_col) / std::sqrt(inv(offset_col, offset_col) * inv(shift_col, shift_col));
+  double rss = 0.0;
+  for (Index k : c.train) rss += ev.residual(k) * ev.residual(k);
+  const double dof = std::max(1.0, static_cast<double>(c.train.size()) - static_cast<double>(d.x.cols()));
+  st.offset_shift_correlation = std::isfinite(corr) ? corr : 1.0;
+  st.offset_standard_error = std::sqrt(rss / dof * inv(offset_col, offset_col)) * scale(offset_col);
+  st.ambiguous = std::abs(st.offset_shift_correlation) >= AnalysisResult::kAmbiguousCorrelation;
+}
+
 std::vector<Parameter> effect_parameters(const std::vector<Parameter>& all, const std::string& name) {
   std::vector<Parameter> out;
   for (const auto& p : all)
@@ -752,6 +779,7 @@ AnalysisResult analyze(const Recording& raw, const AnalysisOptions& opt) {
       cur = evaluate(c, spec, std::move(d), b);
       update_refs(c, cur);
     }
+    if (best->score.name == "temperature_drift") split_uncertainty(c, spec, cur, st);
     st.delta_max = spec.delta_max;
     st.curve_knots = static_cast<int>(spec.knots.size());
     st.parameters = effect_parameters(model_parameters(c, spec, cur), best->score.name);
@@ -838,7 +866,7 @@ std::vector<CalibratorTerm> calibrator_terms(const AnalysisResult& r) {
         }
         if (p.name == "load_dependent_friction.reference_force") out.push_back({"load_friction_reference_kN", p.value});
       }
-      if (s.evidence.name == "temperature_drift") {
+      if (s.evidence.name == "temperature_drift" && !s.ambiguous) {
         if (p.name == "temperature_drift.sensor_offset_per_degC") {
           out.push_back({"load_cell_offset_kN_per_C", std::clamp(p.value, -1.0, 1.0)});
         }

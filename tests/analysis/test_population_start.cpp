@@ -11,6 +11,7 @@
 #include "bbw/analysis/analysis.hpp"
 #include "bbw/calibration/maxwell_slip.hpp"
 #include "bbw/scenario/corner_sim.hpp"
+#include "bbw/scenario/load.hpp"
 #include "bbw/scenario/population.hpp"
 
 using namespace bbw;
@@ -138,4 +139,61 @@ TEST(AnalyzeBounds, UnphysicalCreepIsRejectedWithItsReason) {
     }
   }
   EXPECT_TRUE(listed) << "creep not in `rejected`";
+}
+
+namespace {
+
+// The paper rig at 40 C ramping 0.5 C/s with a load-cell offset drifting 0.02 kN/C; x_low is
+// where each sweep cycle turns (0.3 rev: the pads open; 1.0 rev: they never do).
+analysis::Recording thermal_rig(double x_low_rev) {
+  auto sc = scenario::load_scenario(source_dir() + "/config/scenarios/paper_rig_44C.yaml");
+  auto& k = sc.corners[0];
+  k.conditions.temperature_C = 40.0;
+  k.conditions.temperature_rate_C_per_s = 0.5;
+  k.effects.thermal_drift.enabled = true;
+  std::get<scenario::PaperSweep>(k.drive.position.segments[0]).x_low_rev = x_low_rev;
+  scenario::CornerSim sim(sc, 0);
+  analysis::Recording r;
+  const auto steps = static_cast<std::size_t>(std::llround(sc.duration_s / sc.plant_dt_s));
+  for (std::size_t i = 0; i < steps; ++i) {
+    const auto& s = sim.step(sc.plant_dt_s);
+    r.time_s.push_back(s.time_s);
+    r.position.push_back(s.position_rev);
+    r.force.push_back(s.force_internal_kN);
+    r.truth.push_back(s.force_external_kN);
+    r.temperature.push_back(s.temperature_C);
+    r.velocity.push_back(s.speed_rev_s);
+  }
+  return r;
+}
+
+const analysis::Step* drift_step(const analysis::AnalysisResult& r) {
+  for (const auto& s : r.steps)
+    if (s.evidence.name == "temperature_drift") return &s;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST(AnalyzeAmbiguity, OffsetVersusCurveShiftIsAmbiguousOnlyWhenThePadsNeverOpen) {
+  const auto open = analysis::analyze(thermal_rig(0.3), analysis::AnalysisOptions{});
+  const auto closed = analysis::analyze(thermal_rig(1.0), analysis::AnalysisOptions{});
+  const auto* so = drift_step(open);
+  const auto* sc = drift_step(closed);
+  ASSERT_NE(so, nullptr);
+  std::printf("pads open: correlation %.4f, offset SE %.5f kN/C, ambiguous %d\n", so->offset_shift_correlation,
+              so->offset_standard_error, so->ambiguous ? 1 : 0);
+  if (sc) {
+    std::printf("pads closed: correlation %.4f, offset SE %.5f kN/C, ambiguous %d\n", sc->offset_shift_correlation,
+                sc->offset_standard_error, sc->ambiguous ? 1 : 0);
+  }
+  EXPECT_FALSE(so->ambiguous);
+  ASSERT_NE(sc, nullptr) << "with the pads closed the drift is still an effect, only its split is unknown";
+  EXPECT_TRUE(sc->ambiguous);
+  // An ambiguous split proposes no online load-cell offset term; a clear one does.
+  bool open_term = false, closed_term = false;
+  for (const auto& t : analysis::calibrator_terms(open)) open_term = open_term || t.key == "load_cell_offset_kN_per_C";
+  for (const auto& t : analysis::calibrator_terms(closed)) closed_term = closed_term || t.key == "load_cell_offset_kN_per_C";
+  EXPECT_TRUE(open_term);
+  EXPECT_FALSE(closed_term);
 }

@@ -116,6 +116,12 @@ std::string analysis_json(const LoadedRecording& in, const analysis::AnalysisOpt
     w.value("runner_up_relative_drop", s.runner_up_relative_drop);
     w.end_object();
     params_json(w, "parameters", s.parameters);
+    if (s.evidence.name == "temperature_drift") {
+      // Load-cell offset versus the curve's shift with temperature: can they be told apart?
+      w.value("ambiguous", s.ambiguous);
+      w.value("offset_shift_correlation", s.offset_shift_correlation);
+      w.value("offset_standard_error", s.offset_standard_error);
+    }
     w.value("delta_max", s.delta_max);
     w.value("curve_knots", s.curve_knots);
     errors_json(w, "errors_after", s.errors, in.force_unit);
@@ -250,6 +256,7 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
   };
   row("baseline", r.baseline);
   for (const auto& s : r.steps) row("+ " + s.evidence.name, s.errors);
+  row("final", r.final_errors);
   if (r.gross_outliers > 0) {
     md << "\n" << r.gross_outliers << " gross outlier(s) (more than 10 times the 0.5-99.5 % span outside it) "
        << "replaced by the previous good value before fitting; first:";
@@ -260,7 +267,6 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
      << " samples before the position had travelled 2 Delta_max from its running extreme (the "
         "friction's initial state is unknown until then; baseline: "
      << r.baseline.unscored_initial_samples << ").\n";
-  row("final", r.final_errors);
   md << "\nAll figures in " << u << ".\n\n## Steps\n\n";
   if (r.steps.empty()) md << "No candidate met the acceptance rule.\n";
   for (const auto& s : r.steps) {
@@ -268,6 +274,14 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
        << fmt(100.0 * s.evidence.relative_drop, 3) << " %, t = " << fmt(s.evidence.t_statistic, 3) << "); runner-up "
        << s.runner_up << " (" << fmt(100.0 * s.runner_up_relative_drop, 3) << " %). Parameters:";
     for (const auto& p : s.parameters) md << " " << p.name << " = " << fmt(p.value) << " " << p.unit << ";";
+    if (s.evidence.name == "temperature_drift") {
+      md << (s.ambiguous ? " **Ambiguous split**: the load-cell offset and the curve's shift with temperature cannot be "
+                           "told apart on this recording"
+                         : " Offset and curve shift told apart")
+         << " (correlation of the two coefficients " << fmt(s.offset_shift_correlation, 3)
+         << ", offset standard error " << fmt(s.offset_standard_error, 3) << " per degC, a white-noise lower bound)"
+         << (s.ambiguous ? "; no online term is proposed for it." : ".");
+    }
     md << "\n";
   }
   const auto terms = analysis::calibrator_terms(r);

@@ -71,6 +71,15 @@ struct Step {
   double delta_max = 0.0;             // re-chosen after the step
   int curve_knots = 0;                // re-chosen after the step
   ErrorFigures errors;
+  // temperature_drift: whether the load-cell offset can be told apart from the curve's own
+  // shift with temperature on this recording. With the pads never open the two columns are
+  // nearly collinear: |offset_shift_correlation| (of the two fitted coefficients, from the
+  // fit's inverse normal matrix) >= AnalysisResult::kAmbiguousCorrelation makes the split
+  // ambiguous; offset_standard_error is the offset's standard error (white-noise assumption,
+  // so a lower bound). An ambiguous split calls for no online term.
+  bool ambiguous = false;
+  double offset_shift_correlation = 0.0;
+  double offset_standard_error = 0.0;
 };
 
 struct StructureFinding {
@@ -84,6 +93,7 @@ struct StructureFinding {
 };
 
 struct AnalysisResult {
+  static constexpr double kAmbiguousCorrelation = 0.95;
   std::size_t samples = 0;
   double dt_s = 0.0;
   std::size_t holdout_samples = 0;
