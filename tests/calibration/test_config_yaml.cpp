@@ -4,6 +4,7 @@
 
 #include <dirent.h>
 
+#include <cstdio>
 #include <fstream>
 #include <string>
 
@@ -166,4 +167,21 @@ TEST(CalibratorConfigYaml, ShippedRobustStateFitsIn24KiB) {
   // At least the sample store: L + 1 slots of x, f (double) and M element states (float).
   EXPECT_GT(cal.state_bytes(), static_cast<std::size_t>(c.samples_L + 1) *
                                    (2 * sizeof(double) + static_cast<std::size_t>(c.elements_M) * sizeof(float)));
+}
+
+TEST(CalibratorConfigYaml, ShippedRobustWithEachEffectTermStateBytes) {
+  auto c = load_config(source_dir() + "/config/calibrator/robust.yaml");
+  const std::size_t plain = bbw::calibration::Calibrator(c).state_bytes();
+  auto delay = c;
+  delay.force_delay_s = 0.005;  // the line is sized for 2.5 kHz: 16 slots, not 128
+  const std::size_t with_delay = bbw::calibration::Calibrator(delay).state_bytes();
+  EXPECT_EQ(with_delay - plain, (16u - 2u) * 2u * sizeof(double));
+  EXPECT_LE(with_delay, 24u * 1024u) << with_delay;
+  auto all = delay;
+  all.viscous_friction = true;
+  all.backlash_width_rev = 0.05;
+  all.load_friction_gain = 0.9;
+  all.load_cell_offset_kN_per_C = 0.02;
+  std::printf("state bytes: shipped %zu, + force delay %zu, + every term %zu\n", plain, with_delay,
+              bbw::calibration::Calibrator(all).state_bytes());
 }

@@ -96,7 +96,7 @@ Calibrator::Calibrator(const CalibratorConfig& config)
       store_(config.samples_L, config.elements_M + (config.viscous_friction ? 1 : 0), config.x_max_rev - config.x_min_rev,
              config.f_max_kN - config.f_min_kN, config.drop_rule),
       states_known_rule_(config.delta_max_rev),
-      position_delay_(config.force_delay_s > 0.0 ? CalibratorConfig::kForceDelayCapacity : 2),
+      position_delay_(CalibratorConfig::force_delay_slots(config.force_delay_s)),
       solver_(kCurveTerms + config.elements_M + (config.viscous_friction ? 1 : 0)) {
   const auto m = static_cast<std::size_t>(m_);
   const auto p = static_cast<std::size_t>(p_);
