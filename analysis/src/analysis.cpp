@@ -182,7 +182,9 @@ Evaluated evaluate(const Context& c, const Spec& s, Design d, const Eigen::Vecto
   std::vector<Index> all(c.n);
   std::iota(all.begin(), all.end(), Index{0});
   e.rms_residual = rms_of(ev.residual, all);
-  e.max_residual = ev.residual.cwiseAbs().maxCoeff();
+  const std::size_t first = std::min(calibration::first_known_sample(d.x_eff.data(), c.n, s.delta_max), c.n - 1);
+  e.unscored_initial_samples = first;
+  e.max_residual = ev.residual.tail(static_cast<Index>(c.n - first)).cwiseAbs().maxCoeff();
   e.holdout_rms_residual = rms_of(ev.residual, c.holdout);
   if (!c.rec.truth.empty()) {
     e.has_truth = true;
@@ -208,10 +210,11 @@ Evaluated evaluate(const Context& c, const Spec& s, Design d, const Eigen::Vecto
     for (std::size_t k = 0; k < c.n; ++k) {
       const double err = c.rec.force[k] - sensor(static_cast<Index>(k)) - truth[k];
       ev.truth_error[k] = err;
+      if (k < first) continue;
       ss += err * err;
       mx = std::max(mx, std::abs(err));
     }
-    e.rms_truth_error = std::sqrt(ss / static_cast<double>(c.n));
+    e.rms_truth_error = std::sqrt(ss / static_cast<double>(c.n - first));
     e.max_truth_error = mx;
   }
   ev.design = std::move(d);
@@ -382,6 +385,10 @@ struct Scored {
   Spec spec;
 };
 
+// "" when the candidate's own fitted parameters are physical, else which one is not.
+std::string physical_bounds_violation(const Context& c, const Spec& s, const Design& d, const Eigen::VectorXd& b,
+                                      const std::string& name);
+
 Scored score_candidate(const Context& c, const Spec& s, const Candidate& cand, const Eigen::VectorXd& current_residual,
                        double current_holdout_rms) {
   Scored out;
@@ -419,6 +426,8 @@ Scored score_candidate(const Context& c, const Spec& s, const Candidate& cand, c
   out.score.t_statistic = paired_t(current_residual, r, c.holdout, c.opt.significance_blocks);
   out.score.significant =
       out.score.relative_drop >= c.opt.min_relative_drop && out.score.t_statistic >= c.opt.min_t_statistic;
+  out.score.rejected_reason = physical_bounds_violation(c, out.spec, d, b, cand.name);
+  if (!out.score.rejected_reason.empty()) out.score.significant = false;
   return out;
 }
 
@@ -480,11 +489,63 @@ std::vector<Parameter> model_parameters(const Context& c, const Spec& s, const E
   return out;
 }
 
+// Offset-versus-shift split of a temperature_drift step: the correlation of the two fitted
+// coefficients and the offset's standard error, from sigma^2 (X'X)^-1 over the fit rows.
+void split_uncertainty(const Context& c, const Spec& s, const Evaluated& ev, Step& st) {
+  const Design& d = ev.design;
+  Index offset_col = -1;
+  for (Index j = 0; j < d.x.cols(); ++j) {
+    const int o = d.owner[static_cast<std::size_t>(j)];
+    if (o >= 0 && s.columns[static_cast<std::size_t>(o)].kind == EffectKind::TemperatureDrift) {
+      offset_col = j;
+      break;
+    }
+  }
+  if (offset_col < 0 || offset_col + 2 >= d.x.cols()) return;
+  const Index shift_col = offset_col + 2;  // columns: offset, gain, shift
+  const LsqProblem p = normal_equations(d.x, c.y, c.train);
+  const Eigen::VectorXd scale = p.gram.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd g = scale.asDiagonal() * p.gram * scale.asDiagonal();
+  const Eigen::MatrixXd inv = g.ldlt().solve(Eigen::MatrixXd::Identity(g.rows(), g.cols()));
+  const double corr = inv(offset_col, shift_col) / std::sqrt(inv(offset_col, offset_col) * inv(shift_col, shift_col));
+  double rss = 0.0;
+  for (Index k : c.train) rss += ev.residual(k) * ev.residual(k);
+  const double dof = std::max(1.0, static_cast<double>(c.train.size()) - static_cast<double>(d.x.cols()));
+  st.offset_shift_correlation = std::isfinite(corr) ? corr : 1.0;
+  st.offset_standard_error = std::sqrt(rss / dof * inv(offset_col, offset_col)) * scale(offset_col);
+  st.ambiguous = std::abs(st.offset_shift_correlation) >= AnalysisResult::kAmbiguousCorrelation;
+}
+
 std::vector<Parameter> effect_parameters(const std::vector<Parameter>& all, const std::string& name) {
   std::vector<Parameter> out;
   for (const auto& p : all)
     if (p.name.rfind(name + ".", 0) == 0) out.push_back(p);
   return out;
+}
+
+std::string physical_bounds_violation(const Context& c, const Spec& s, const Design& d, const Eigen::VectorXd& b,
+                                      const std::string& name) {
+  Evaluated ev;
+  ev.design = d;
+  ev.coef = b;
+  auto ends_with = [](const std::string& a, const std::string& tail) {
+    return a.size() >= tail.size() && a.compare(a.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  for (const auto& p : effect_parameters(model_parameters(c, s, ev), name)) {
+    std::string rule;
+    if (ends_with(p.name, ".unrelaxed_fraction") && !(p.value >= 0.0 && p.value < 1.0)) rule = "must be in [0, 1)";
+    if ((ends_with(p.name, ".mass") || ends_with(p.name, ".delay_s") || ends_with(p.name, ".width") ||
+         (name == "viscous_friction" && ends_with(p.name, ".coefficient"))) &&
+        !(p.value >= 0.0)) {
+      rule = "must be >= 0";
+    }
+    if (!rule.empty()) {
+      std::ostringstream o;
+      o << p.name << " = " << p.value << " " << rule;
+      return o.str();
+    }
+  }
+  return "";
 }
 
 Vec display_signal(const Context& c, const Spec& s, const std::string& name) {
@@ -525,9 +586,62 @@ void check(const Recording& rec) {
 
 }  // namespace
 
-AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
+namespace {
+
+std::size_t reject_in(std::vector<double>& v, const std::string& name, std::vector<std::string>* where) {
+  if (v.size() < 20) return 0;
+  std::vector<double> sorted;
+  sorted.reserve(v.size());
+  for (double x : v)
+    if (std::isfinite(x)) sorted.push_back(x);
+  if (sorted.size() < 20) return 0;
+  const auto at = [&](double q) {
+    const auto i = static_cast<std::ptrdiff_t>(q * static_cast<double>(sorted.size() - 1));
+    std::nth_element(sorted.begin(), sorted.begin() + i, sorted.end());
+    return sorted[static_cast<std::size_t>(i)];
+  };
+  const double lo = at(0.005), hi = at(0.995);
+  const double span = std::max(hi - lo, 1e-12 * std::max(std::abs(lo), std::abs(hi)));
+  const double min_ok = lo - 10.0 * span, max_ok = hi + 10.0 * span;
+  std::size_t count = 0;
+  double last_good = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    if (v[k] >= min_ok && v[k] <= max_ok) {
+      last_good = v[k];
+      continue;
+    }
+    ++count;
+    if (where && where->size() < 10) where->push_back(name + "@" + std::to_string(k));
+    if (std::isfinite(last_good)) {
+      v[k] = last_good;
+    } else {  // at the start: the next good value
+      std::size_t j = k + 1;
+      while (j < v.size() && !(v[j] >= min_ok && v[j] <= max_ok)) ++j;
+      v[k] = j < v.size() ? v[j] : 0.5 * (lo + hi);
+    }
+  }
+  return count;
+}
+
+}  // namespace
+
+std::size_t reject_gross_outliers(Recording& rec, std::vector<std::string>* where) {
+  std::size_t n = reject_in(rec.position, "position", where);
+  n += reject_in(rec.force, "force", where);
+  n += reject_in(rec.truth, "truth", where);
+  n += reject_in(rec.temperature, "temperature", where);
+  n += reject_in(rec.velocity, "velocity", where);
+  n += reject_in(rec.acceleration, "acceleration", where);
+  for (auto& ch : rec.channels) n += reject_in(ch.values, "channel:" + ch.name, where);
+  return n;
+}
+
+AnalysisResult analyze(const Recording& raw, const AnalysisOptions& opt) {
   opt.validate();
-  check(rec);
+  check(raw);
+  Recording rec = raw;
+  std::vector<std::string> outlier_where;
+  const std::size_t outliers = reject_gross_outliers(rec, &outlier_where);
   Context c(rec, opt);
   c.n = rec.time_s.size();
   c.dt = (rec.time_s.back() - rec.time_s.front()) / static_cast<double>(c.n - 1);
@@ -548,6 +662,8 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
   }
 
   AnalysisResult res;
+  res.gross_outliers = outliers;
+  res.gross_outlier_samples = outlier_where;
   res.samples = c.n;
   res.dt_s = c.dt;
   std::ostringstream how;
@@ -619,6 +735,7 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
   res.residual_before.assign(cur.residual.data(), cur.residual.data() + cur.residual.size());
   res.truth_error_before = cur.truth_error;
 
+  std::vector<CandidateScore> earlier_bounds;  // earlier rounds' candidates refused for their bounds
   for (int round = 0; round <= opt.max_steps; ++round) {
     const auto cands = candidates_for(c, spec);
     if (cands.empty()) break;
@@ -630,6 +747,7 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
     std::vector<CandidateScore> scores;
     for (const auto& s : scored) scores.push_back(s.score);
     res.rounds.push_back(scores);
+
     // The best significant candidate by held-out RMS.
     const Scored* best = nullptr;
     for (const auto& s : scored)
@@ -642,6 +760,8 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
       if (best) res.structure_notes.push_back("max_steps reached with a significant candidate left");
       break;
     }
+    for (const auto& s : scored)
+      if (!s.score.rejected_reason.empty()) earlier_bounds.push_back(s.score);
     Step st;
     st.evidence = best->score;
     for (const auto& s : scored)
@@ -659,6 +779,7 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
       cur = evaluate(c, spec, std::move(d), b);
       update_refs(c, cur);
     }
+    if (best->score.name == "temperature_drift") split_uncertainty(c, spec, cur, st);
     st.delta_max = spec.delta_max;
     st.curve_knots = static_cast<int>(spec.knots.size());
     st.parameters = effect_parameters(model_parameters(c, spec, cur), best->score.name);
@@ -674,6 +795,7 @@ AnalysisResult analyze(const Recording& rec, const AnalysisOptions& opt) {
     }
     res.steps.push_back(st);
   }
+  res.rejected.insert(res.rejected.end(), earlier_bounds.begin(), earlier_bounds.end());
   res.final_parameters = model_parameters(c, spec, cur);
   res.final_errors = cur.errors;
   res.residual_after.assign(cur.residual.data(), cur.residual.data() + cur.residual.size());
@@ -744,7 +866,7 @@ std::vector<CalibratorTerm> calibrator_terms(const AnalysisResult& r) {
         }
         if (p.name == "load_dependent_friction.reference_force") out.push_back({"load_friction_reference_kN", p.value});
       }
-      if (s.evidence.name == "temperature_drift") {
+      if (s.evidence.name == "temperature_drift" && !s.ambiguous) {
         if (p.name == "temperature_drift.sensor_offset_per_degC") {
           out.push_back({"load_cell_offset_kN_per_C", std::clamp(p.value, -1.0, 1.0)});
         }

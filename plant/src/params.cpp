@@ -58,6 +58,18 @@ void PlantParams::validate() const {
            "must be in [0, 3]");
   in_range("key_friction.force_share_exponent", key_friction.force_share_exponent, -3.0, 3.0,
            "must be in [-3, 3]");
+  non_negative("key_friction.threshold_min_rev", key_friction.threshold_min_rev);
+  non_negative("key_friction.threshold_max_rev", key_friction.threshold_max_rev);
+  if (key_friction.threshold_max_rev > 0.0 && !(key_friction.threshold_max_rev >= key_friction.threshold_min_rev)) {
+    in_range("key_friction.threshold_max_rev", key_friction.threshold_max_rev, key_friction.threshold_min_rev, 1e300,
+             "must be >= threshold_min_rev");
+  }
+  if (key_friction.threshold_distribution == ThresholdDistribution::LogUniform) {
+    positive("key_friction.threshold_min_rev", key_friction.threshold_min_rev);
+    positive("key_friction.threshold_max_rev", key_friction.threshold_max_rev);
+  }
+  in_range("key_friction.share_log_sigma", key_friction.share_log_sigma, 0.0, 3.0, "must be in [0, 3]");
+  in_range("key_friction.initial_deflection", key_friction.initial_deflection, -1.0, 1.0, "must be in [-1, 1]");
   in_range("sensors.resolver_counts_per_motor_rev", sensors.resolver_counts_per_motor_rev, 1,
            1 << 24, "must be in [1, 16777216]");
   non_negative("sensors.resolver_noise_rev", sensors.resolver_noise_rev);

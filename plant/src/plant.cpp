@@ -53,6 +53,8 @@ void Plant::reset(double position_rev) {
   s_.curve_force_kN = curve_.force_kN(position_rev, s_.temperature_C, s_.wear_rev);
   s_.force_true_kN = s_.curve_force_kN;
   friction_.reset(position_rev);
+  s_.key_friction_kN = friction_.force_kN();
+  s_.friction_kN = s_.key_friction_kN;
   force_delay_.clear();
   meas_ = Measurement{};
   sample_sensors();

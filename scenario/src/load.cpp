@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "bbw/plant/params_yaml.hpp"
+#include "bbw/scenario/population.hpp"
 
 namespace bbw::scenario {
 
@@ -223,6 +224,14 @@ Scenario read_scenario(Reader& r, const ExtraKeys& extra) {
   if (s.ccu_period_s < s.plant_dt_s) r.fail("ccu_period_s", "must be >= plant_dt_s");
   s.plant_file = config::resolve_relative(r.file(), r.string("plant"));
   s.plant = plant::load_plant_params(s.plant_file);
+  if (auto pop = r.optional_map("population")) {
+    // One member of a caliper population replaces the plant file's caliper.
+    const std::string spec_file = config::resolve_relative(r.file(), pop->string("spec"));
+    const PopulationSpec spec = load_population_spec(spec_file);
+    const auto member = static_cast<int>(pop->integer("member", 0, spec.count - 1));
+    pop->finish();
+    s.plant = population_member(spec, member).params;
+  }
   if (auto c = r.optional_map("controller")) {
     s.controller = read_controller(*c);
   }
@@ -248,7 +257,70 @@ Scenario read_scenario(Reader& r, const ExtraKeys& extra) {
   return s;
 }
 
+plant::Interval read_interval(Reader& r, const std::string& key, const plant::Interval& fallback, const Range& range) {
+  if (!r.has(key)) {
+    r.fail(key, "required key is missing");
+  }
+  const std::vector<double> v = r.numbers(key, range);
+  if (v.size() != 2) r.fail(key, "must be a [min, max] pair");
+  if (v[0] > v[1]) r.fail(key, "min must be <= max");
+  (void)fallback;
+  return plant::Interval{v[0], v[1]};
+}
+
+PopulationSpec read_population(Reader& r) {
+  PopulationSpec p;
+  p.file = r.file();
+  p.name = r.string("name");
+  if (p.name.empty()) r.fail("name", "must not be empty");
+  p.seed = static_cast<std::uint64_t>(r.integer("seed", 0, std::numeric_limits<std::int64_t>::max()));
+  p.count = static_cast<int>(r.integer("count", 1, 100000));
+  p.temperatures_C = r.numbers("temperatures_C", Range::closed(-40.0, 140.0));
+  if (p.temperatures_C.empty()) r.fail("temperatures_C", "must list at least one temperature");
+  p.duration_s = r.number("duration_s", Range{0.0, 1.0e5, true, false});
+  p.plant_dt_s = r.number("plant_dt_s", Range::closed(1.0e-5, 0.01));
+  p.plant_file = config::resolve_relative(r.file(), r.string("plant"));
+  p.base = plant::load_plant_params(p.plant_file);
+  Reader d = r.map("drive");
+  p.drive = read_drive(d);
+  if (p.drive.mode != DriveMode::Position) r.fail("drive", "a population drive must be mode 'position' (a rig)");
+  Reader g = r.map("ranges");
+  plant::PopulationRanges& q = p.ranges;
+  q.elements = read_interval(g, "elements", q.elements, Range::closed(1, 1000));
+  q.threshold_min_rev = read_interval(g, "threshold_min_rev", q.threshold_min_rev, Range{0.0, 5.0, true, false});
+  q.threshold_span_ratio = read_interval(g, "threshold_span_ratio", q.threshold_span_ratio, Range::closed(1.0, 1e6));
+  q.threshold_max_limit_rev = g.number("threshold_max_limit_rev", Range{0.0, 5.0, true, false});
+  q.log_uniform_share = g.number("log_uniform_share", Range::closed(0.0, 1.0));
+  q.half_width_kN = read_interval(g, "half_width_kN", q.half_width_kN, Range{0.0, 100.0, true, false});
+  q.force_share_exponent = read_interval(g, "force_share_exponent", q.force_share_exponent, Range::closed(-3.0, 3.0));
+  q.share_log_sigma = read_interval(g, "share_log_sigma", q.share_log_sigma, Range::closed(0.0, 3.0));
+  q.initial_deflection = read_interval(g, "initial_deflection", q.initial_deflection, Range::closed(-1.0, 1.0));
+  q.contact_rev = read_interval(g, "contact_rev", q.contact_rev, Range::closed(-2.0, 10.0));
+  q.stiffness_scale = read_interval(g, "stiffness_scale", q.stiffness_scale, Range::closed(0.01, 100.0));
+  q.contact_shift_rev_per_C = read_interval(g, "contact_shift_rev_per_C", q.contact_shift_rev_per_C, Range::closed(-1.0, 1.0));
+  q.stiffness_change_per_C = read_interval(g, "stiffness_change_per_C", q.stiffness_change_per_C, Range::closed(-0.01, 0.01));
+  q.load_cell_noise_kN = read_interval(g, "load_cell_noise_kN", q.load_cell_noise_kN, Range::closed(0.0, 10.0));
+  g.finish();
+  try {
+    q.validate();
+  } catch (const std::invalid_argument& e) {
+    g.fail("", e.what());
+  }
+  r.finish();
+  return p;
+}
+
 }  // namespace
+
+PopulationSpec load_population_spec(const std::string& file) {
+  Reader r = Reader::from_file(file);
+  return read_population(r);
+}
+
+PopulationSpec load_population_spec_string(const std::string& text, const std::string& name) {
+  Reader r = Reader::from_string(text, name);
+  return read_population(r);
+}
 
 Scenario load_scenario(const std::string& file, const ExtraKeys& extra) {
   Reader r = Reader::from_file(file);

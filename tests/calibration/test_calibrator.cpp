@@ -126,12 +126,16 @@ TEST(Calibrator, StateFitsTheMemoryBudgetAtPaperSize) {
   Calibrator cal(c);
   EXPECT_LE(cal.state_bytes(), 16u * 1024u) << cal.state_bytes();
   EXPECT_GT(cal.state_bytes(), 65u * 10u * 8u);  // at least the store itself
-  // With both optional effect terms (a 13th parameter and the 128-sample delay line).
+  // With both optional effect terms (a 13th parameter and the delay line, sized for 2.5 kHz).
   c.viscous_friction = true;
   c.force_delay_s = 0.005;
   Calibrator with_effects(c);
   EXPECT_LE(with_effects.state_bytes(), 16u * 1024u) << with_effects.state_bytes();
-  EXPECT_GT(with_effects.state_bytes(), cal.state_bytes() + 2u * 128u * sizeof(double));
+  EXPECT_GT(with_effects.state_bytes(),
+            cal.state_bytes() + 2u * (CalibratorConfig::force_delay_slots(0.005) - 2u) * sizeof(double));
+  EXPECT_EQ(CalibratorConfig::force_delay_slots(0.005), 16u);
+  EXPECT_EQ(CalibratorConfig::force_delay_slots(0.05), 128u);
+  EXPECT_EQ(CalibratorConfig::force_delay_slots(0.0), 2u);
 }
 
 TEST(Calibrator, ResetCurveRestartsFromGivenCurve) {

@@ -4,9 +4,11 @@
 
 #include <dirent.h>
 
+#include <cstdio>
 #include <fstream>
 #include <string>
 
+#include "bbw/calibration/calibrator.hpp"
 #include "bbw/calibration/config_yaml.hpp"
 
 using bbw::calibration::load_config;
@@ -81,13 +83,13 @@ TEST(CalibratorConfigYaml, UnknownKey) {
 }
 
 TEST(CalibratorConfigYaml, MissingKey) {
-  const auto e = load_broken(replace(robust_text(), "samples_L: 64\n", ""));
+  const auto e = load_broken(replace(robust_text(), "samples_L: 128\n", ""));
   EXPECT_EQ(e.key_path(), "samples_L");
   EXPECT_EQ(e.rule(), "required key is missing");
 }
 
 TEST(CalibratorConfigYaml, WrongType) {
-  const auto text = replace(robust_text(), "delta_max_rev: 0.4", "delta_max_rev: wide");
+  const auto text = replace(robust_text(), "delta_max_rev: 0.8", "delta_max_rev: wide");
   const auto e = load_broken(text);
   EXPECT_EQ(e.key_path(), "delta_max_rev");
   EXPECT_EQ(e.line(), line_of(text, "delta_max_rev"));
@@ -95,7 +97,7 @@ TEST(CalibratorConfigYaml, WrongType) {
 }
 
 TEST(CalibratorConfigYaml, OutOfRange) {
-  auto e = load_broken(replace(robust_text(), "elements_M: 8", "elements_M: 0"));
+  auto e = load_broken(replace(robust_text(), "elements_M: 16", "elements_M: 0"));
   EXPECT_EQ(e.key_path(), "elements_M");
   EXPECT_EQ(e.rule(), "must be an integer in [1, 64], got 0");
   e = load_broken(replace(robust_text(), "  geometric_ratio: 0.6", "  geometric_ratio: 1.5"));
@@ -109,7 +111,7 @@ TEST(CalibratorConfigYaml, OutOfRange) {
 
 TEST(CalibratorConfigYaml, CrossFieldRuleNamesTheField) {
   // samples_L must leave room for 2 (4 + M) rows: a rule between two fields.
-  const auto e = load_broken(replace(robust_text(), "samples_L: 64", "samples_L: 10"));
+  const auto e = load_broken(replace(robust_text(), "samples_L: 128", "samples_L: 10"));
   EXPECT_NE(e.rule().find("samples_L = 10"), std::string::npos) << e.what();
 }
 
@@ -154,4 +156,32 @@ TEST(CalibratorConfigYaml, BacklashAndLoadFrictionTermsLoadAndAreBounded) {
     EXPECT_EQ(e.line(), line_of(text, k.key));
     EXPECT_NE(e.rule().find(k.rule_part), std::string::npos) << e.what();
   }
+}
+
+// Issue 13: the shipped robust config is one for every caliper; its calibrator must stay within
+// 24 KiB of state (effect terms off, as shipped).
+TEST(CalibratorConfigYaml, ShippedRobustStateFitsIn24KiB) {
+  const auto c = load_config(source_dir() + "/config/calibrator/robust.yaml");
+  const bbw::calibration::Calibrator cal(c);
+  EXPECT_LE(cal.state_bytes(), 24u * 1024u) << cal.state_bytes();
+  // At least the sample store: L + 1 slots of x, f (double) and M element states (float).
+  EXPECT_GT(cal.state_bytes(), static_cast<std::size_t>(c.samples_L + 1) *
+                                   (2 * sizeof(double) + static_cast<std::size_t>(c.elements_M) * sizeof(float)));
+}
+
+TEST(CalibratorConfigYaml, ShippedRobustWithEachEffectTermStateBytes) {
+  auto c = load_config(source_dir() + "/config/calibrator/robust.yaml");
+  const std::size_t plain = bbw::calibration::Calibrator(c).state_bytes();
+  auto delay = c;
+  delay.force_delay_s = 0.005;  // the line is sized for 2.5 kHz: 16 slots, not 128
+  const std::size_t with_delay = bbw::calibration::Calibrator(delay).state_bytes();
+  EXPECT_EQ(with_delay - plain, (16u - 2u) * 2u * sizeof(double));
+  EXPECT_LE(with_delay, 24u * 1024u) << with_delay;
+  auto all = delay;
+  all.viscous_friction = true;
+  all.backlash_width_rev = 0.05;
+  all.load_friction_gain = 0.9;
+  all.load_cell_offset_kN_per_C = 0.02;
+  std::printf("state bytes: shipped %zu, + force delay %zu, + every term %zu\n", plain, with_delay,
+              bbw::calibration::Calibrator(all).state_bytes());
 }

@@ -131,8 +131,8 @@ TEST(SampleStore, NormalisesByRangesAndKeepsRows) {
   s.add(0.6, 40.0, r2);  // d = sqrt(0.01 + 0.16) = 0.41
   s.add(2.0, 40.0, r3);  // d = 1.4 -> closest is pair 2-3 (0.41), sample 2 dropped
   EXPECT_DOUBLE_EQ(s.x_rev(1), 0.6);
-  EXPECT_DOUBLE_EQ(s.n_row(1)[0], 4.0);
-  EXPECT_DOUBLE_EQ(s.n_row(2)[1], 7.0);
+  EXPECT_FLOAT_EQ(s.n_row(1)[0], 4.0f);
+  EXPECT_FLOAT_EQ(s.n_row(2)[1], 7.0f);
   EXPECT_DOUBLE_EQ(s.min_x_rev(), 0.0);
   EXPECT_DOUBLE_EQ(s.max_x_rev(), 2.0);
 }

@@ -13,6 +13,7 @@
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/plant/params_yaml.hpp"
 #include "bbw/scenario/load.hpp"
+#include "bbw/scenario/population.hpp"
 
 namespace fs = std::filesystem;
 
@@ -27,6 +28,7 @@ TEST(EveryConfig, EachYamlFileLoadsWithItsFoldersLoader) {
       {"calibrator", [](const std::string& f) { bbw::calibration::load_config(f); }},
       {"analysis", [](const std::string& f) { bbw::analyze::load_options_file(f); }},
       {"faults", [](const std::string& f) { bbw::faults::load_monitor_params(f); }},
+      {"population", [](const std::string& f) { bbw::scenario::load_population_spec(f); }},
   };
   int loaded = 0;
   for (const auto& entry : fs::recursive_directory_iterator(root)) {

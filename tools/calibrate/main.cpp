@@ -57,7 +57,9 @@ bool parse(int argc, char** argv, Args& a) {
   return true;
 }
 
-void write_plots(const std::string& dir, bool has_truth) {
+// has_scored: some sample was scored (a fit was accepted); without one the error plot has no
+// point and gnuplot refuses it, so it is left out.
+void write_plots(const std::string& dir, bool has_truth, bool has_scored) {
   using bbw::plot::quote;
   const std::string est = quote(dir + "/estimates.csv");
   const std::string pf = quote(dir + "/curve.csv");
@@ -72,7 +74,7 @@ void write_plots(const std::string& dir, bool has_truth) {
   s += "plot " + est + " using 1:4 with lines lc rgb '#1f77b4' title 'estimate'";
   if (has_truth) s += ", " + est + " using 1:7 with lines lc rgb '#2ca02c' title 'truth'";
   s += "\n";
-  if (has_truth) {
+  if (has_truth && has_scored) {
     s += "set output " + quote(dir + "/error_time.png") + "\n";
     s += "set ylabel 'error [kN]'\nset title 'Estimate error against time, scored after warm-up (Fig. 16)'\n";
     s += "plot " + est + " using 1:($10 > 0 ? $8 : 1/0) with lines lc rgb '#d62728' title 'estimate - truth'\n";
@@ -206,7 +208,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     try {
-      write_plots(a.out, has_truth);
+      write_plots(a.out, has_truth, res.score.samples_scored > 0);
     } catch (const std::exception& e) {
       std::cerr << "bbw_calibrate: plots: " << e.what() << " (summary.json and the CSV files are written)\n";
       return 1;

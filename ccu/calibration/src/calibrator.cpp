@@ -95,7 +95,8 @@ Calibrator::Calibrator(const CalibratorConfig& config)
       detector_(config.start_lag_n0, robust_ ? config.start_margin_rev : 0.0),
       store_(config.samples_L, config.elements_M + (config.viscous_friction ? 1 : 0), config.x_max_rev - config.x_min_rev,
              config.f_max_kN - config.f_min_kN, config.drop_rule),
-      position_delay_(config.force_delay_s > 0.0 ? CalibratorConfig::kForceDelayCapacity : 2),
+      states_known_rule_(config.delta_max_rev),
+      position_delay_(CalibratorConfig::force_delay_slots(config.force_delay_s)),
       solver_(kCurveTerms + config.elements_M + (config.viscous_friction ? 1 : 0)) {
   const auto m = static_cast<std::size_t>(m_);
   const auto p = static_cast<std::size_t>(p_);
@@ -104,6 +105,7 @@ Calibrator::Calibrator(const CalibratorConfig& config)
   thresholds(m, config.delta_max_rev, geometric, config.geometric_ratio, friction_.delta_rev.data());
   friction_.stiffness_kN_per_rev.assign(m, 0.0);
   phi_kN_.assign(m + static_cast<std::size_t>(e_), 0.0);
+  identified_.assign(m + static_cast<std::size_t>(e_), 0);
 
   const auto n_pf = static_cast<std::size_t>(config.pf_points_N) + 1;
   pf_x_rev_.resize(n_pf);
@@ -123,6 +125,7 @@ Calibrator::Calibrator(const CalibratorConfig& config)
     vel_x_rev_.assign(static_cast<std::size_t>(config.velocity_window), 0.0);
   }
   start_pos_rev_.assign(m, 0.0);
+  residual_kN_.assign(static_cast<std::size_t>(robust_ ? config.residual_window : 1), 0.0);
   gram_.assign(p * p, 0.0);
   rhs_.assign(p, 0.0);
   theta_.assign(p, 0.0);
@@ -141,7 +144,7 @@ std::size_t Calibrator::state_bytes() const {
          vb(pf_x_rev_) + vb(pf_f_kN_) + vb(pf_proj_) + (store_.bytes() - sizeof(store_)) +
          (solver_.bytes() - sizeof(solver_)) + vb(element_pos_rev_) + vb(n_now_) + vb(vel_t_s_) + vb(vel_x_rev_) + 2 * position_delay_.capacity() * sizeof(double) + vb(start_pos_rev_) +
          vb(gram_) + vb(rhs_) + vb(theta_) + vb(row_) + vb(full_row_) + vb(n_replay_) + vb(pos_replay_) + vb(column_on_) +
-         vb(column_map_) + vb(nonneg_flags_) + static_cast<std::size_t>(2 * config_.start_lag_n0 + 1) * sizeof(double);
+         vb(column_map_) + vb(nonneg_flags_) + vb(identified_) + vb(residual_kN_) + static_cast<std::size_t>(2 * config_.start_lag_n0 + 1) * sizeof(double);
 }
 
 void Calibrator::reset_curve(const Curve& curve) {
@@ -206,14 +209,15 @@ void Calibrator::for_each_fit_row(std::size_t columns, F&& f) {
   double* row = row_.data();
   for (std::size_t r = 0; r < store_.size(); ++r) {
     const double x = store_.x_rev(r);
-    const double* n = store_.n_row(r);
-    if (!streaming_) {
-      elements_step(x, friction_.delta_rev.data(), pos_replay_.data(), static_cast<std::size_t>(m_), nullptr,
-                    n_replay_.data());
+    const float* stored = store_.n_row(r);
+    double* n = n_replay_.data();
+    if (streaming_) {
+      for (int i = 0; i < m_ + e_; ++i) n[i] = stored[i];
+    } else {
+      elements_step(x, friction_.delta_rev.data(), pos_replay_.data(), static_cast<std::size_t>(m_), nullptr, n);
       const double scale = load_scale(x);
-      for (int i = 0; i < m_; ++i) n_replay_[static_cast<std::size_t>(i)] *= scale;
-      for (int i = 0; i < e_; ++i) n_replay_[static_cast<std::size_t>(m_ + i)] = n[m_ + i];
-      n = n_replay_.data();
+      for (int i = 0; i < m_; ++i) n[i] *= scale;
+      for (int i = 0; i < e_; ++i) n[m_ + i] = stored[m_ + i];
     }
     regressor_row(x, n, full);
     double b = store_.f_kN(r);
@@ -241,7 +245,10 @@ bool Calibrator::end_cycle() {
   for (int j = 0; j < p_; ++j) {
     bool on = true;
     if (j >= kCurveTerms && j < kCurveTerms + m_ && robust_ && config_.identify_per_element) {
-      on = span >= 2.0 * friction_.delta_rev[static_cast<std::size_t>(j - kCurveTerms)];
+      const auto i = static_cast<std::size_t>(j - kCurveTerms);
+      // An element never identified yet is fitted provisionally from a narrower cycle (its
+      // partial ramps still carry its stiffness) rather than left at zero.
+      on = span >= 2.0 * friction_.delta_rev[i] || !identified_[i];
     }
     column_on_[static_cast<std::size_t>(j)] = on ? 1 : 0;
     if (on) {
@@ -310,8 +317,14 @@ bool Calibrator::end_cycle() {
     const auto i = static_cast<std::size_t>(column_map_[a] - kCurveTerms);
     const bool element = i < static_cast<std::size_t>(m_);
     const double phi_new = (robust_ || !element) ? theta_[a] : theta_[a] * friction_.delta_rev[i];
-    const double w = (robust_ && stats_.fits_accepted > 0) ? config_.k_smoothing : 1.0;
+    // Smoothing starts with an element's second identification: the first replaces the
+    // zero it started from (a wide friction's large elements are identified cycles later).
+    // Running mean over an element's first identifications, then the exponential smoothing.
+    const double w = (robust_ && identified_[i]) ? std::max(config_.k_smoothing, 1.0 / (1.0 + identified_[i])) : 1.0;
     phi_kN_[i] = (1.0 - w) * phi_kN_[i] + w * phi_new;
+    if (!element || !robust_ || !config_.identify_per_element || span >= 2.0 * friction_.delta_rev[i]) {
+      if (identified_[i] < 100) ++identified_[i];
+    }
     if (element) friction_.stiffness_kN_per_rev[i] = phi_kN_[i] / friction_.delta_rev[i];
     else friction_.viscous_kN_per_rev_per_s = phi_kN_[i] / config_.viscous_speed_scale_rev_per_s;
   }
@@ -397,12 +410,12 @@ Estimate Calibrator::update(const Sample& s) {
     x_now = delayed ? play_step(pulled, s.position_rev, config_.backlash_width_rev) : x;
   }
   if (!have_time_) {
-    first_x_rev_ = x;
     for (auto& p : element_pos_rev_) p = x;
   }
   last_time_s_ = s.time_s;
   have_time_ = true;
-  if (!states_known_) states_known_ = !streaming_ || std::fabs(x - first_x_rev_) >= config_.delta_max_rev;
+  // The recording may start with the friction deflected either way (StatesKnown).
+  if (!states_known_) states_known_ = !streaming_ || states_known_rule_.update(x);
 
   const bool start = detector_.update(x) && states_known_;
   if (start && (!in_cycle_ || samples_since_start_ >= static_cast<std::uint64_t>(config_.samples_L))) {
@@ -436,7 +449,10 @@ Estimate Calibrator::update(const Sample& s) {
   for (int i = 0; i < m_ + e_; ++i) f_fric += phi_kN_[static_cast<std::size_t>(i)] * n_now_[static_cast<std::size_t>(i)];
 
   if (in_cycle_) {
-    store_.add(x, f_c, n_now_.data());
+    // Robust mode fits only samples inside the curve's range [x_min, x_max]: below it the pads
+    // open and the cubic cannot follow the contact kink, and the large elements' partial
+    // ramps would absorb that misfit as friction. The element states still run everywhere.
+    if (!robust_ || (x >= config_.x_min_rev && x <= config_.x_max_rev)) store_.add(x, f_c, n_now_.data());
     ++samples_since_start_;
   }
 
@@ -445,6 +461,18 @@ Estimate Calibrator::update(const Sample& s) {
   e.curve_force_kN = curve_.force_kN(x_now);
   e.force_kN = f_c - f_fric;
   if (delayed) e.force_kN += e.curve_force_kN - curve_.force_kN(x);
+  if (residual_kN_.size() > 1) {
+    // f_hat = C(x_now) + mean of the last residuals; a new curve restarts the mean (the stored
+    // residuals were taken against the old one).
+    if (e.fit_accepted) residual_count_ = 0;
+    const std::size_t w = residual_kN_.size();
+    residual_head_ = (residual_head_ + 1) % w;
+    residual_kN_[residual_head_] = e.force_kN - e.curve_force_kN;
+    if (residual_count_ < w) ++residual_count_;
+    double sum = 0.0;
+    for (std::size_t k = 0; k < residual_count_; ++k) sum += residual_kN_[(residual_head_ + w - k) % w];
+    e.force_kN = e.curve_force_kN + sum / static_cast<double>(residual_count_);
+  }
   e.calibrated = stats_.fits_accepted > 0;
   return e;
 }

@@ -51,6 +51,9 @@ void CalibratorConfig::validate() const {
   if (!(load_cell_offset_kN_per_C >= -1.0 && load_cell_offset_kN_per_C <= 1.0)) bad("load_cell_offset_kN_per_C", load_cell_offset_kN_per_C, "must be in [-1, 1]");
   if (!(load_cell_offset_reference_C >= -50.0 && load_cell_offset_reference_C <= 150.0)) bad("load_cell_offset_reference_C", load_cell_offset_reference_C, "must be in [-50, 150]");
   if (!(k_smoothing > 0.0 && k_smoothing <= 1.0)) bad("k_smoothing", k_smoothing, "must be in (0, 1]");
+  if (residual_window < 1 || residual_window > kMaxResidualWindow) {
+    bad("residual_window", residual_window, "must be in [1, 64]");
+  }
 }
 
 }  // namespace bbw::calibration

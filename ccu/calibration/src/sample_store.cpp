@@ -20,7 +20,7 @@ SampleStore::SampleStore(int capacity_L, int row_width_M, double x_range_rev, do
   inv_f2_ = 1.0 / (f_range_kN * f_range_kN);
   x_.assign(capacity_ + 1, 0.0);
   f_.assign(capacity_ + 1, 0.0);
-  n_.assign((capacity_ + 1) * std::max<std::size_t>(width_, 1), 0.0);
+  n_.assign((capacity_ + 1) * std::max<std::size_t>(width_, 1), 0.0f);
   order_.assign(capacity_ + 1, 0);
   d2_.assign(capacity_, 0.0);
   clear();
@@ -40,15 +40,29 @@ double SampleStore::dist2(std::size_t a, std::size_t b) const {
 void SampleStore::write(std::size_t phys, double x, double f, const double* n_row) {
   x_[phys] = x;
   f_[phys] = f;
-  if (n_row) std::copy(n_row, n_row + width_, n_.begin() + static_cast<std::ptrdiff_t>(phys * width_));
+  if (n_row) {
+    float* dst = &n_[phys * width_];
+    for (std::size_t i = 0; i < width_; ++i) dst[i] = static_cast<float>(n_row[i]);
+  }
 }
 
 void SampleStore::rescan_settled_min() {
-  std::size_t j = 0;
+  // Two passes: the smallest value, then its first index (the first-index-on-ties rule). The
+  // value pass keeps eight independent minima so that it is not one long chain of dependent
+  // min instructions (at L = 128 that chain was half the calibrator's per-sample time).
   const std::size_t n = capacity_ - 1;
-  for (std::size_t k = 1; k < n; ++k) {
-    if (d2_[k] < d2_[j]) j = k;
+  const double* d = d2_.data();
+  double acc[8];
+  for (double& a : acc) a = d[0];
+  std::size_t k = 1;
+  for (; k + 8 <= n; k += 8) {
+    for (std::size_t u = 0; u < 8; ++u) acc[u] = d[k + u] < acc[u] ? d[k + u] : acc[u];
   }
+  for (; k < n; ++k) acc[0] = d[k] < acc[0] ? d[k] : acc[0];
+  double m = acc[0];
+  for (std::size_t u = 1; u < 8; ++u) m = acc[u] < m ? acc[u] : m;
+  std::size_t j = 0;
+  while (d[j] != m) ++j;
   settled_min_ = j;
 }
 
@@ -90,7 +104,8 @@ double SampleStore::max_x_rev() const {
 }
 
 std::size_t SampleStore::bytes() const {
-  return sizeof(*this) + (x_.capacity() + f_.capacity() + n_.capacity() + d2_.capacity()) * sizeof(double) +
+  return sizeof(*this) + (x_.capacity() + f_.capacity() + d2_.capacity()) * sizeof(double) +
+         n_.capacity() * sizeof(float) +
          order_.capacity() * sizeof(std::uint32_t);
 }
 

@@ -21,6 +21,7 @@ void errors_json(json::Writer& w, const std::string& key, const analysis::ErrorF
   w.value("rms_residual", e.rms_residual);
   w.value("max_residual", e.max_residual);
   w.value("holdout_rms_residual", e.holdout_rms_residual);
+  w.value("unscored_initial_samples", e.unscored_initial_samples);  // left out of the max figures
   if (e.has_truth) {
     w.value("rms_truth_error", e.rms_truth_error);
     w.value("max_truth_error", e.max_truth_error);
@@ -47,6 +48,7 @@ void score_json(json::Writer& w, const analysis::CandidateScore& s) {
   w.value("relative_drop", s.relative_drop);
   w.value("t_statistic", s.t_statistic);
   w.value("significant", s.significant);
+  if (!s.rejected_reason.empty()) w.value("rejected_reason", s.rejected_reason);
 }
 
 std::string fmt(double v, int prec = 4) {
@@ -77,6 +79,10 @@ std::string analysis_json(const LoadedRecording& in, const analysis::AnalysisOpt
   w.value("samples", r.samples);
   w.value("dt_s", r.dt_s);
   w.value("holdout_samples", r.holdout_samples);
+  w.value("gross_outliers", r.gross_outliers);  // replaced by the previous good value, not fitted
+  w.begin_array("gross_outlier_samples");
+  for (const auto& g : r.gross_outlier_samples) w.value("", g);
+  w.end_array();
   w.end_object();
   w.value("force_unit", in.force_unit);
   w.value("position_unit", in.position_unit);
@@ -111,6 +117,12 @@ std::string analysis_json(const LoadedRecording& in, const analysis::AnalysisOpt
     w.value("runner_up_relative_drop", s.runner_up_relative_drop);
     w.end_object();
     params_json(w, "parameters", s.parameters);
+    if (s.evidence.name == "temperature_drift") {
+      // Load-cell offset versus the curve's shift with temperature: can they be told apart?
+      w.value("ambiguous", s.ambiguous);
+      w.value("offset_shift_correlation", s.offset_shift_correlation);
+      w.value("offset_standard_error", s.offset_standard_error);
+    }
     w.value("delta_max", s.delta_max);
     w.value("curve_knots", s.curve_knots);
     errors_json(w, "errors_after", s.errors, in.force_unit);
@@ -246,6 +258,16 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
   row("baseline", r.baseline);
   for (const auto& s : r.steps) row("+ " + s.evidence.name, s.errors);
   row("final", r.final_errors);
+  if (r.gross_outliers > 0) {
+    md << "\n" << r.gross_outliers << " gross outlier(s) (more than 10 times the 0.5-99.5 % span outside it) "
+       << "replaced by the previous good value before fitting; first:";
+    for (const auto& g : r.gross_outlier_samples) md << " " << g;
+    md << ".\n";
+  }
+  md << "\nMax figures leave out the " << r.final_errors.unscored_initial_samples
+     << " samples before the position had travelled 2 Delta_max from its running extreme (the "
+        "friction's initial state is unknown until then; baseline: "
+     << r.baseline.unscored_initial_samples << ").\n";
   md << "\nAll figures in " << u << ".\n\n## Steps\n\n";
   if (r.steps.empty()) md << "No candidate met the acceptance rule.\n";
   for (const auto& s : r.steps) {
@@ -253,6 +275,14 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
        << fmt(100.0 * s.evidence.relative_drop, 3) << " %, t = " << fmt(s.evidence.t_statistic, 3) << "); runner-up "
        << s.runner_up << " (" << fmt(100.0 * s.runner_up_relative_drop, 3) << " %). Parameters:";
     for (const auto& p : s.parameters) md << " " << p.name << " = " << fmt(p.value) << " " << p.unit << ";";
+    if (s.evidence.name == "temperature_drift") {
+      md << (s.ambiguous ? " **Ambiguous split**: the load-cell offset and the curve's shift with temperature cannot be "
+                           "told apart on this recording"
+                         : " Offset and curve shift told apart")
+         << " (correlation of the two coefficients " << fmt(s.offset_shift_correlation, 3)
+         << ", offset standard error " << fmt(s.offset_standard_error, 3) << " per degC, a white-noise lower bound)"
+         << (s.ambiguous ? "; no online term is proposed for it." : ".");
+    }
     md << "\n";
   }
   const auto terms = analysis::calibrator_terms(r);
@@ -268,11 +298,13 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
     }
     md << "```\n";
   }
-  md << "\n## Rejected (last round)\n\n| candidate | held-out RMS | drop | t |\n|---|---|---|---|\n";
+  md << "\n## Rejected (last round, and earlier candidates outside physical bounds)\n\n"
+        "| candidate | held-out RMS | drop | t | reason |\n|---|---|---|---|---|\n";
   for (const auto& s : r.rejected)
     md << "| " << s.name << (s.hyper_name.empty() ? "" : " (" + s.hyper_name + " = " + fmt(s.hyper_value) + ")")
        << " | " << fmt(s.holdout_rms) << " | " << fmt(100.0 * s.relative_drop, 3) << " % | "
-       << fmt(s.t_statistic, 3) << " |\n";
+       << fmt(s.t_statistic, 3) << " | " << (s.rejected_reason.empty() ? "not significant" : s.rejected_reason)
+       << " |\n";
   md << "\n## Structure left in the final residual\n\n";
   md << (r.unexplained_structure ? "**Structure is left that no candidate explains.**\n\n"
                                  : "No structure above the thresholds is left.\n\n");

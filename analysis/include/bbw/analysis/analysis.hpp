@@ -35,6 +35,11 @@ struct ErrorFigures {
   bool has_truth = false;
   double rms_truth_error = 0.0;  // clamp-force estimate minus truth
   double max_truth_error = 0.0;
+  // The recording may start with the friction deflected; the model's elements start relaxed.
+  // Samples before the position has travelled 2 Delta_max from its running extreme
+  // (calibration::StatesKnown, the online calibrator's rule) are not scored: the truth figures
+  // and max_residual leave them out, and this counts them.
+  std::size_t unscored_initial_samples = 0;
 };
 
 struct Parameter {
@@ -52,6 +57,10 @@ struct CandidateScore {
   double relative_drop = 0.0;   // 1 - holdout_rms / current holdout rms
   double t_statistic = 0.0;     // paired held-out improvement, block means
   bool significant = false;
+  // Why the candidate cannot be accepted whatever its scores: a fitted parameter outside its
+  // physical bounds (masses, viscous coefficients, delays >= 0; creep's unrelaxed fraction in
+  // [0, 1)). Empty when within bounds.
+  std::string rejected_reason;
 };
 
 struct Step {
@@ -62,6 +71,15 @@ struct Step {
   double delta_max = 0.0;             // re-chosen after the step
   int curve_knots = 0;                // re-chosen after the step
   ErrorFigures errors;
+  // temperature_drift: whether the load-cell offset can be told apart from the curve's own
+  // shift with temperature on this recording. With the pads never open the two columns are
+  // nearly collinear: |offset_shift_correlation| (of the two fitted coefficients, from the
+  // fit's inverse normal matrix) >= AnalysisResult::kAmbiguousCorrelation makes the split
+  // ambiguous; offset_standard_error is the offset's standard error (white-noise assumption,
+  // so a lower bound). An ambiguous split calls for no online term.
+  bool ambiguous = false;
+  double offset_shift_correlation = 0.0;
+  double offset_standard_error = 0.0;
 };
 
 struct StructureFinding {
@@ -75,9 +93,16 @@ struct StructureFinding {
 };
 
 struct AnalysisResult {
+  static constexpr double kAmbiguousCorrelation = 0.95;
   std::size_t samples = 0;
   double dt_s = 0.0;
   std::size_t holdout_samples = 0;
+  // Gross outliers (a reading far outside its channel's bulk, e.g. one position of 1e10):
+  // replaced by the channel's previous good value before anything is fitted, and counted.
+  // A value counts as gross when it lies more than 10 times the 0.5-99.5 % percentile span
+  // outside that span. Names: "position@1234".
+  std::size_t gross_outliers = 0;
+  std::vector<std::string> gross_outlier_samples;  // the first 10
   std::string differentiator;  // how velocity and acceleration were obtained
 
   int curve_knots = 0;  // 0: the eq. 5 cubic; else interior knots of the cubic spline
@@ -88,7 +113,9 @@ struct AnalysisResult {
   std::vector<Parameter> final_parameters;  // every term of the final model
   ErrorFigures final_errors;
   std::vector<std::vector<CandidateScore>> rounds;  // every round's scores, best first
-  std::vector<CandidateScore> rejected;             // the last round (none was accepted)
+  // The last round (none was accepted), then every candidate of earlier rounds refused for a
+  // parameter outside its physical bounds (rejected_reason says which).
+  std::vector<CandidateScore> rejected;
 
   std::vector<StructureFinding> structure;
   bool unexplained_structure = false;
@@ -101,6 +128,11 @@ struct AnalysisResult {
   std::vector<double> display_regressor;
   std::vector<double> velocity;
 };
+
+// Replaces gross outliers in position, force, truth, temperature, velocity, acceleration and the
+// channels (rule above) by the previous good value of the same channel; returns how many, with
+// the first 10 named in `where` when given.
+std::size_t reject_gross_outliers(Recording& rec, std::vector<std::string>* where = nullptr);
 
 // Runs the whole analysis. Throws std::invalid_argument for an unusable recording (too short,
 // mismatched lengths, non-uniform or non-increasing time, constant position).

@@ -14,7 +14,7 @@ class KeyFriction {
  public:
   explicit KeyFriction(const KeyFrictionParams& params);  // throws std::invalid_argument
 
-  // All elements relaxed (zero deflection) at x.
+  // Input at x, every element at the params' initial_deflection (0: relaxed).
   void reset(double x_rev);
   // Moves the input to x; returns the friction force sum K_i Delta_i n_i (kN). No allocation.
   double step(double x_rev);
@@ -30,6 +30,7 @@ class KeyFriction {
   std::vector<double> k_kN_per_rev_;
   std::vector<double> pos_rev_;
   double force_kN_ = 0.0;
+  double initial_deflection_ = 0.0;
 };
 
 }  // namespace bbw::plant

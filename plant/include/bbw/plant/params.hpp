@@ -49,6 +49,15 @@ struct ClampCurveParams {
 // structure_seed) from a log-normal distribution with the given median and log-sigma, and whose
 // force shares K_i Delta_i follow the smooth density Delta_i^force_share_exponent, normalised so
 // that sum K_i Delta_i = half_width_kN.
+//
+// The caliper population (bbw/plant/population.hpp) also draws log-uniform thresholds in
+// [threshold_min_rev, threshold_max_rev], clips log-normal draws to that range when
+// threshold_max_rev > 0, makes the force shares uneven (each share times exp(share_log_sigma
+// N(0, 1)), from the structure seed), and starts the friction deflected: at reset every element
+// sits at normalised deflection initial_deflection in [-1, 1] (1 = all slipping upwards). The
+// defaults reproduce the plant file's model (log-normal, unclipped, smooth shares, relaxed).
+enum class ThresholdDistribution { LogNormal, LogUniform };
+
 struct KeyFrictionParams {
   double half_width_kN = 1.0;
   int elements = 40;
@@ -56,6 +65,11 @@ struct KeyFrictionParams {
   double threshold_log_sigma = 0.6;
   double force_share_exponent = 0.5;
   std::uint64_t structure_seed = 20240521;
+  ThresholdDistribution threshold_distribution = ThresholdDistribution::LogNormal;
+  double threshold_min_rev = 0.0;
+  double threshold_max_rev = 0.0;     // 0: log-normal draws unclipped
+  double share_log_sigma = 0.0;
+  double initial_deflection = 0.0;
 };
 
 // Sensor models. Noise is Gaussian with the given RMS, drawn from the corner's seeded generator.

@@ -12,6 +12,7 @@
 #include "bbw/calibration/config.hpp"
 #include "bbw/common/delay_line.hpp"
 #include "bbw/calibration/curve.hpp"
+#include "bbw/calibration/maxwell_slip.hpp"
 #include "bbw/calibration/cycle_detector.hpp"
 #include "bbw/calibration/sample_store.hpp"
 
@@ -109,10 +110,12 @@ class Calibrator {
   std::uint64_t samples_since_start_ = 0;
   double last_time_s_ = 0.0;
   bool have_time_ = false;
-  // Streaming element states are exact once x has moved Delta_max one way from the first
-  // sample (every element has then slipped); cycle starts before that are ignored.
-  double first_x_rev_ = 0.0;
+  // Streaming element states are exact once x has moved 2 Delta_max from its running lowest
+  // or highest position (every element has then slipped, whatever its initial deflection);
+  // cycle starts before that are ignored.
+  StatesKnown states_known_rule_;
   bool states_known_ = false;
+  std::vector<char> identified_;  // per phi: identified by at least one accepted fit
 
   std::vector<double> element_pos_rev_;  // live element positions x_i
   std::vector<double> n_now_;            // live n_i, then the extra regressors
@@ -127,6 +130,9 @@ class Calibrator {
   // Load-cell thermal offset: the last finite temperature (the reference until one arrives).
   double temperature_C_ = 0.0;
   std::vector<double> start_pos_rev_;    // x0_i at the current cycle's start (replay)
+  // Residual averaging (config residual_window): ring of the last residuals f_c - friction - C(x).
+  std::vector<double> residual_kN_;
+  std::size_t residual_head_ = 0, residual_count_ = 0;
 
   // Fit workspace, sized at construction.
   BoundedLeastSquares solver_;

@@ -1,6 +1,7 @@
 // Calibrator settings. Plain struct; validate() names the field, value and rule it breaks.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 
 #include <string>
@@ -51,6 +52,12 @@ struct CalibratorConfig {
   double start_margin_rev = 0.02;    // robust start detector hysteresis (0 = the paper's eq. 6)
   double k_smoothing = 1.0;          // weight of a new fit's friction stiffness (1 = replace)
   bool identify_per_element = true;  // update K_i only when the cycle span >= 2 Delta_i
+  // Load-cell noise passes straight into f_hat = f_c - friction. The estimate is the curve at
+  // the present position plus the mean of the last residual_window residuals
+  // r = f_c - friction - C(x) (the curve error and friction misfit vary slowly; the noise is
+  // white), so the noise falls by sqrt(window). 1 = off; at most kMaxResidualWindow samples.
+  int residual_window = 1;
+  static constexpr int kMaxResidualWindow = 64;
 
   // Optional model terms for effects found offline (./bbw analyze), per caliper.
   // viscous_friction: a load-cell term c_v * v (v = resolver speed, or the slope of the last
@@ -60,11 +67,18 @@ struct CalibratorConfig {
   int velocity_window = 9;                      // samples, for the position-slope fallback
   // force_delay_s: the load cell lags the resolver by this much (a sensor or filter delay
   // ./bbw analyze measures; 0 = off, at most 0.05). The model pairs each load-cell reading with
-  // the position force_delay_s earlier (a 128-sample delay line: enough at up to 2.5 kHz), and
+  // the position force_delay_s earlier (a delay line sized for up to 2.5 kHz, force_delay_slots), and
   // the estimate is carried to the present along the curve:
   //   f_hat(t) = f_c(t) - friction(x(t - d)) + C(x(t)) - C(x(t - d)).
   double force_delay_s = 0.0;
   static constexpr std::size_t kForceDelayCapacity = 128;
+  // Delay-line slots for a delay d: enough at up to 2.5 kHz (ceil(d * 2500) + 3), at most
+  // kForceDelayCapacity; 2 when off (issue 13: 16 slots for 5 ms keep the state within 24 KiB).
+  static std::size_t force_delay_slots(double force_delay_s) {
+    if (!(force_delay_s > 0.0)) return 2;
+    const double slots = std::ceil(force_delay_s * 2500.0) + 3.0;
+    return slots >= static_cast<double>(kForceDelayCapacity) ? kForceDelayCapacity : static_cast<std::size_t>(slots);
+  }
   // load_friction_gain: the key friction grows with the clamp force (./bbw analyze's
   // load_dependent_friction: friction_gain_at_full_curve at its reference_force):
   //   friction = sum_i K_i Delta_i n_i * (1 + g max(C(x), 0) / F_ref),

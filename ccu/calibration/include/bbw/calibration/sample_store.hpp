@@ -4,7 +4,9 @@
 // the L distances between consecutive slots, the smallest (index j) decides: j = L drops the
 // new sample, otherwise one sample of the closest pair is dropped (the paper's sample j, or
 // j+1 under the other reading) and the later samples shift left, so the new one ends in slot L.
-// Each slot also keeps M regressor values (the element states n_i at that sample).
+// Each slot also keeps M regressor values (the element states n_i at that sample), stored as
+// float: they lie in [-1, 1] (the effect regressors are scaled to order 1), float keeps them
+// to 1e-7, and it halves the store (issue 13's wider element set within 24 KiB).
 //
 // Memory is sized at construction; add() does not allocate. Slots are addressed through an
 // order array, so a shift moves small indices, not rows.
@@ -29,7 +31,7 @@ class SampleStore {
   // k-th kept sample in time order, 0-based.
   double x_rev(std::size_t k) const { return x_[order_[k]]; }
   double f_kN(std::size_t k) const { return f_[order_[k]]; }
-  const double* n_row(std::size_t k) const { return &n_[order_[k] * width_]; }
+  const float* n_row(std::size_t k) const { return &n_[order_[k] * width_]; }
   double min_x_rev() const;
   double max_x_rev() const;
   std::uint64_t dropped() const { return dropped_; }
@@ -45,7 +47,8 @@ class SampleStore {
   double inv_x2_;
   double inv_f2_;
   DropRule rule_;
-  std::vector<double> x_, f_, n_;     // capacity + 1 physical slots
+  std::vector<double> x_, f_;         // capacity + 1 physical slots
+  std::vector<float> n_;
   std::vector<std::uint32_t> order_;  // logical slot -> physical slot
   std::vector<double> d2_;            // d2_[k]: squared distance between logical k and k + 1
   std::size_t count_ = 0;
