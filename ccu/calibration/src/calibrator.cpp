@@ -419,7 +419,9 @@ Estimate Calibrator::update(const Sample& s) {
 
   const bool start = detector_.update(x) && states_known_;
   if (start && (!in_cycle_ || samples_since_start_ >= static_cast<std::uint64_t>(config_.samples_L))) {
-    if (in_cycle_) {
+    if (in_cycle_ && fits_held_) {
+      ++stats_.fits_held;
+    } else if (in_cycle_) {
       if (end_cycle()) {
         ++stats_.fits_accepted;
         if (stats_.first_fit_time_s < 0.0) stats_.first_fit_time_s = s.time_s;

@@ -42,6 +42,7 @@ struct Stats {
   std::uint64_t cycles_detected = 0;
   std::uint64_t fits_accepted = 0;
   std::uint64_t fits_rejected = 0;
+  std::uint64_t fits_held = 0;         // cycles ended while fits were held (hold_fits): not fitted
   double first_fit_time_s = -1.0;      // time of the first accepted fit; -1 before it
   double last_fit_rms_kN = 0.0;        // residual RMS of the last cycle fit
   double last_fit_span_rev = 0.0;      // displacement span of the last cycle fitted
@@ -74,10 +75,16 @@ class Calibrator {
   // Friction stiffnesses from elsewhere (e.g. the last good state); sizes must match M.
   void set_friction_stiffness(const std::vector<double>& k_kN_per_rev);
 
+  // While held, a cycle that ends is not fitted (counted in Stats::fits_held) and a new cycle
+  // starts as usual: the CCU holds fits while its fault monitor suspects the load cell, so a
+  // fault's first samples are never learnt as the caliper's curve (docs/faults.md).
+  void hold_fits(bool held) { fits_held_ = held; }
+
   // Bytes owned by this object (itself plus its buffers), for the memory budget.
   std::size_t state_bytes() const;
 
  private:
+  bool fits_held_ = false;
   void start_cycle(double x_rev);
   bool end_cycle();
   template <class F>

@@ -136,6 +136,9 @@ class FaultMonitor {
   double last_residual_kN() const { return residual_.residual_kN(); }
   // The last residual minus its reference level (NaN where the residual is).
   double last_residual_change_kN() const { return residual_.change_kN(); }
+  // A residual disagreement is under way but not yet confirmed: the calibrator must not learn
+  // from these samples (CornerSupervisor holds its fits).
+  bool residual_suspect() const { return residual_.suspect(); }
   // Share of large residual steps in the noise window.
   double last_noise_fraction() const { return noise_.fraction(); }
   Target corner() const { return corner_; }

@@ -27,6 +27,8 @@ class ResidualDetector {
     curve_max_rev_ = max_rev;
   }
   double residual_kN() const { return residual_kN_; }
+  // A disagreement is under way but not yet confirmed (persist_s).
+  bool suspect() const { return suspect_; }
   double change_kN() const { return change_kN_; }
 
  private:
