@@ -268,23 +268,23 @@ int main(int argc, char** argv) {
   };
   std::map<std::string, unsigned> incarnations;  // corner -> processes started
   auto spawn_corner = [&](const std::string& c, unsigned incarnation, double resume_at_s) {
-    std::vector<std::string> argv{corner_bin, "--corner", c, "--scenario", scenario_file, "--domain", dom,
+    std::vector<std::string> args{corner_bin, "--corner", c, "--scenario", scenario_file, "--domain", dom,
                                   "--run-id", run_hex, "--mode", mode, "--stats", corner_stats_file(c, incarnation),
                                   "--periods-log", out_dir + "/corner_" + c + "_periods.csv",
                                   "--discovery-timeout", disc};
     if (process_faults) {
-      argv.push_back("--process-faults");
+      args.push_back("--process-faults");
       // In lockstep the CCU may hold the clock for a restarted corner for up to the discovery
       // timeout: the other corners must wait for their next command at least that long.
-      argv.insert(argv.end(), {"--peer-timeout", std::to_string(discovery_s + 10.0)});
+      args.insert(args.end(), {"--peer-timeout", std::to_string(discovery_s + 10.0)});
     }
-    if (secure) argv.insert(argv.end(), {"--secure", keys_dir});
-    argv.insert(argv.end(), profile_args.begin(), profile_args.end());
+    if (secure) args.insert(args.end(), {"--secure", keys_dir});
+    args.insert(args.end(), profile_args.begin(), profile_args.end());
     if (incarnation > 0) {
-      argv.insert(argv.end(), {"--incarnation", std::to_string(incarnation), "--resume-at", std::to_string(resume_at_s)});
+      args.insert(args.end(), {"--incarnation", std::to_string(incarnation), "--resume-at", std::to_string(resume_at_s)});
     }
     const std::string suffix = incarnation == 0 ? "" : "." + std::to_string(incarnation);
-    children.push_back(std::make_unique<Child>("bbw_corner " + c + suffix, argv,
+    children.push_back(std::make_unique<Child>("bbw_corner " + c + suffix, args,
                                                out_dir + "/corner_" + c + suffix + ".out",
                                                out_dir + "/corner_" + c + suffix + ".err"));
     incarnations[c] = incarnation + 1;
