@@ -81,7 +81,7 @@ class CornerApp {
   int run(std::string& error);
   const CornerStats& stats() const { return node_.stats(); }
   bool matched_ccu() const { return matched_ccu_; }  // the CCU's endpoints matched at least once
-  void write_stats(const std::string& file) const;  // key=value (bbw/launch/stats_file.hpp)
+  void write_stats(const std::string& file) const;  // key=value (bbw/runtime/run_stats.hpp)
 
  private:
   bool wait_for_ccu(std::string& error);

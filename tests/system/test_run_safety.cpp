@@ -265,6 +265,44 @@ void stop_midway(int sig, int domain, const std::string& name) {
 TEST(SystemStops, SigtermKeepsAPartialSummaryAndExits143) { stop_midway(SIGTERM, 204, "sigterm"); }
 TEST(SystemStops, SigintKeepsAPartialSummaryAndExits130) { stop_midway(SIGINT, 205, "sigint"); }
 
+// Domain 211 (never joined): a stop while the DDS Security keys are created, before any run
+// process starts, still writes a partial summary marked interrupted and exits 128 + signal.
+// The key script is replaced (BBW_LAUNCH_KEYS_SCRIPT) by one that says it started and waits.
+void stop_before_start(int sig, const std::string& name) {
+  const std::string dir = scratch(name);
+  const std::string marker = dir + "/keys_started";
+  const std::string script = dir + "/slow-keys.sh";
+  {
+    std::ofstream f(script);
+    f << "#!/bin/sh\ntouch '" << marker << "'\nexec sleep 120\n";
+  }
+  fs::permissions(script, fs::perms::owner_all);
+  Launch l(dir, "bbw_launch",
+           launch_argv("tests/system/data/long_stop.yaml", dir + "/out", "lockstep", 211,
+                       {"--secure", "--keys", dir + "/keys"}),
+           {"BBW_LAUNCH_KEYS_SCRIPT=" + script});
+  const auto end = Clock::now() + 30s;
+  while (!fs::exists(marker) && Clock::now() < end && !l.ended_within(20ms)) {
+  }
+  ASSERT_TRUE(fs::exists(marker)) << "the key script never started\n" << l.out() << l.err();
+  l.signal(sig);
+  const auto st = l.wait(30s);
+  EXPECT_TRUE(st.exited && st.code == 128 + sig) << describe(st, l);
+  const std::string j = slurp(dir + "/out/summary.json");
+  ASSERT_FALSE(j.empty()) << "no summary after a stop before the start\n" << l.err();
+  EXPECT_EQ(field(j, "interrupted"), "true") << j;
+  EXPECT_EQ(field(j, "complete"), "false") << j;
+  EXPECT_EQ(field(j, "signal"), sig == SIGINT ? "SIGINT" : "SIGTERM") << j;
+  EXPECT_NE(field(j, "failure").find("before the run's processes started"), std::string::npos) << j;
+  EXPECT_TRUE(objects(j, "processes").empty()) << j;
+  EXPECT_EQ(objects(j, "corners").size(), 4u) << j;
+  EXPECT_FALSE(fs::exists(dir + "/out/ccu.out")) << "a run process was started after the stop";
+  fs::remove_all(dir);
+}
+
+TEST(SystemStops, SigtermWhileKeysAreCreatedKeepsAPartialSummaryAndExits143) { stop_before_start(SIGTERM, "keys_sigterm"); }
+TEST(SystemStops, SigintWhileKeysAreCreatedKeepsAPartialSummaryAndExits130) { stop_before_start(SIGINT, "keys_sigint"); }
+
 // Domain 206 (the killed run) and 207 (the next launch): a SIGKILLed CCU still yields a summary
 // from what the corners logged, naming the lost process; the port files and semaphores its
 // run left in /dev/shm (domain 206's ports, 7400 + 250 * 206 = 58900 and up: no other test uses

@@ -6,28 +6,9 @@
 
 #include "bbw/faults/fault_monitor.hpp"
 #include "bbw/faults/outcome.hpp"
-#include "bbw/launch/stats_file.hpp"
 #include "bbw/node/command_plan.hpp"
 
 namespace bbw::launch {
-
-std::vector<Detection> read_detections(const std::map<std::string, std::string>& st, const std::string& file) {
-  std::vector<Detection> out;
-  const auto n = st.find("detections");
-  if (n == st.end()) return out;
-  const auto count = static_cast<std::size_t>(stat_number(st, "detections", file));
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::string p = "detection." + std::to_string(i) + ".";
-    Detection d;
-    d.corner = st.at(p + "corner");
-    d.finding = st.at(p + "finding");
-    d.part = st.at(p + "part");
-    d.onset_s = stat_number(st, p + "onset_s", file);
-    d.detected_s = stat_number(st, p + "detected_s", file);
-    out.push_back(d);
-  }
-  return out;
-}
 
 std::vector<TimelinePoint> build_timeline(const scenario::Scenario& s,
                                           const std::vector<std::vector<std::pair<double, double>>>& logs) {

@@ -9,20 +9,13 @@
 #include <vector>
 
 #include "bbw/faults/schedule.hpp"
+#include "bbw/runtime/run_stats.hpp"
 #include "bbw/scenario/scenario.hpp"
 
 namespace bbw::launch {
 
-struct Detection {
-  std::string corner;   // FL, FR, RL, RR
-  std::string finding;  // faults::to_string(Finding)
-  std::string part;     // faults::to_string(Part)
-  double onset_s = 0.0;
-  double detected_s = 0.0;
-};
-
-// The detection.N.* keys of ccu.stats (none when the file has no such keys).
-std::vector<Detection> read_detections(const std::map<std::string, std::string>& ccu_stats, const std::string& file);
+// A detection of the CCU's fault monitor as ccu.stats holds it (bbw/runtime/run_stats.hpp).
+using Detection = runtime::DetectionStats;
 
 struct TimelinePoint {
   double time_s = 0.0;          // end of the period

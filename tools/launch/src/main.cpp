@@ -41,6 +41,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <map>
 #include <optional>
@@ -59,7 +60,6 @@
 #include "bbw/common/data_path.hpp"
 #include "bbw/launch/child.hpp"
 #include "bbw/launch/signals.hpp"
-#include "bbw/launch/stats_file.hpp"
 #include "bbw/scenario/load.hpp"
 #include "bbw/scenario/run_checks.hpp"
 #include "bbw/security/dds_security.hpp"
@@ -192,6 +192,34 @@ int main(int argc, char** argv) {
     std::cerr << "bbw_launch: " << e.what() << "\n";
     return 2;
   }
+  // A SIGINT/SIGTERM before the run's processes start (while the keys are created, say) still
+  // leaves a partial summary marked interrupted, and the exit is 128 + the signal.
+  auto stopped_before_start = [&]() -> std::optional<int> {
+    const int sig = stop_signal.load();
+    if (!interrupted.load() || sig == 0) return std::nullopt;
+    const std::string failure = std::string("interrupted by ") + (sig == SIGINT ? "SIGINT" : "SIGTERM") +
+                                " before the run's processes started";
+    std::cerr << "bbw_launch: " << failure << "\n";
+    bbw::launch::PartialRun run;
+    run.scenario = &*scenario;
+    run.scenario_file = scenario_file;
+    run.mode = mode;
+    run.domain = domain;
+    run.run_id = run_hex;
+    run.secure = secure;
+    run.out_dir = out_dir;
+    run.failure = failure;
+    run.interrupted = true;
+    run.signal = sig;
+    try {
+      bbw::launch::write_partial_summary(run);
+      std::cerr << "bbw_launch: partial summary in " << out_dir << "/summary.json\n";
+    } catch (const std::exception& e) {
+      std::cerr << "bbw_launch: partial summary failed: " << e.what() << "\n";
+    }
+    return 128 + sig;
+  };
+  if (const auto rc = stopped_before_start()) return *rc;
   if (secure) {
     // Keys: created by scripts/bbw-keys.sh when any file is missing (idempotent), then checked.
     std::error_code ec;
@@ -224,9 +252,21 @@ int main(int argc, char** argv) {
     };
     if (!check_keys().empty()) {
       std::cout << "bbw_launch: creating DDS Security keys in " << keys_dir << std::endl;
-      Child keys("bbw-keys.sh", {bbw::data::path("scripts/bbw-keys.sh"), keys_dir},
-                 out_dir + "/keys.out", out_dir + "/keys.err");
-      const auto st = keys.wait_until(Clock::now() + 120s);
+      // Test hook: BBW_LAUNCH_KEYS_SCRIPT replaces scripts/bbw-keys.sh (e.g. one that waits, so a
+      // stop during key creation is exercised).
+      const char* keys_script_env = std::getenv("BBW_LAUNCH_KEYS_SCRIPT");
+      const std::string keys_script =
+          keys_script_env && *keys_script_env ? keys_script_env : bbw::data::path("scripts/bbw-keys.sh");
+      Child keys("bbw-keys.sh", {keys_script, keys_dir}, out_dir + "/keys.out", out_dir + "/keys.err");
+      const auto keys_end = Clock::now() + 120s;
+      std::optional<bbw::launch::ExitStatus> st;
+      while (!(st = keys.wait_until(std::min(keys_end, Clock::now() + 100ms))) && Clock::now() < keys_end) {
+        if (interrupted.load()) {
+          keys.stop(1000ms);
+          return *stopped_before_start();
+        }
+      }
+      if (const auto rc = stopped_before_start()) return *rc;
       if (!st || !st->ok()) {
         if (!st) keys.stop(1000ms);
         std::cerr << "bbw_launch: scripts/bbw-keys.sh " << keys_dir << " failed ("
@@ -244,6 +284,7 @@ int main(int argc, char** argv) {
   if (!shm.removed.empty()) {
     std::cout << "bbw_launch: removed " << shm.removed.size() << " stale Fast DDS shared-memory files" << std::endl;
   }
+  if (const auto rc = stopped_before_start()) return *rc;
 
   const std::string bin = bbw::launch::executable_dir();
   // Test hook: BBW_LAUNCH_CORNER_BIN replaces the corner executable (e.g. one that fails to
@@ -263,9 +304,7 @@ int main(int argc, char** argv) {
       corner_restarts ? std::vector<std::string>{"--dds-participant-profile", "bbw_localhost_udp"}
                       : std::vector<std::string>{};
   // Where each corner's incarnations keep their stats and per-period log.
-  auto corner_stats_file = [&](const std::string& c, unsigned n) {
-    return out_dir + "/corner_" + c + (n == 0 ? "" : "." + std::to_string(n)) + ".stats";
-  };
+  auto corner_stats_file = [&](const std::string& c, unsigned n) { return bbw::launch::corner_stats_file(out_dir, c, n); };
   std::map<std::string, unsigned> incarnations;  // corner -> processes started
   auto spawn_corner = [&](const std::string& c, unsigned incarnation, double resume_at_s) {
     std::vector<std::string> argv{corner_bin, "--corner", c, "--scenario", scenario_file, "--domain", dom,
@@ -466,209 +505,24 @@ int main(int argc, char** argv) {
 
   // Summary.
   try {
-    const std::string ccu_stats_file = out_dir + "/ccu.stats";
-    const auto ccu = bbw::launch::read_stats(ccu_stats_file);
-    auto num = [&](const std::map<std::string, std::string>& m, const std::string& k, const std::string& f) {
-      return bbw::launch::stat_number(m, k, f);
-    };
-    const double sim_s = num(ccu, "sim_s", ccu_stats_file);
-    const double wall_s = num(ccu, "wall_s", ccu_stats_file);
-    bbw::json::Writer j;
-    std::vector<bbw::launch::ReportCorner> report_corners;
-    long long published = 0, received = 0, gaps = 0, overruns = 0, cmd_deadlines = 0, in_flight_total = 0;
-    std::map<std::string, double> ccu_lost_s;
-    std::vector<std::vector<std::pair<double, double>>> period_logs;
-    double max_jitter = 0.0;
-    j.begin_object().value("scenario", scenario->name).value("scenario_file", scenario_file).value("mode", mode);
-    j.value("domain", domain).value("run_id", run_hex).value("friction_feedback", feedback).value("secure", secure);
-    j.value("complete", true).value("interrupted", false);
-    // Participants of other bbw runs seen on the domain (by any process of this run).
-    std::vector<bbw::dds::PeerTag> others;
-    {
-      std::vector<std::string> files{ccu_stats_file};
-      for (const auto& [c, n] : incarnations) {
-        for (unsigned k = 0; k < n; ++k) files.push_back(corner_stats_file(c, k));
-      }
-      others = bbw::launch::foreign_runs_in(files);
-    }
-    j.begin_array("other_runs_on_domain");
-    for (const auto& o : others) {
-      j.begin_object().value("run_id", bbw::dds::run_id_hex(o.run_id)).value("pid", static_cast<long long>(o.pid))
-          .value("process", o.name).end_object();
-      std::cerr << "bbw_launch: another bbw run (run id " << bbw::dds::run_id_hex(o.run_id) << ", pid " << o.pid
-                << ", " << o.name << ") is on domain " << domain << "; the run ids kept the two apart\n";
-    }
-    j.end_array();
-    j.begin_array("corners");
-    for (const auto& c : scenario->corners) {
-      // Counters summed over the corner's incarnations (a restarted process has its own file).
-      const std::string cs_file = corner_stats_file(c.name, 0);
-      const auto cs = bbw::launch::read_stats(cs_file);
-      auto corner_sum = [&](const std::string& key) {
-        double v = 0.0;
-        for (unsigned n = 0; n < incarnations[c.name]; ++n) {
-          const std::string f = corner_stats_file(c.name, n);
-          v += num(bbw::launch::read_stats(f), key, f);
-        }
-        return v;
-      };
-      auto corner_max = [&](const std::string& key) {
-        double v = 0.0;
-        for (unsigned n = 0; n < incarnations[c.name]; ++n) {
-          const std::string f = corner_stats_file(c.name, n);
-          v = std::max(v, num(bbw::launch::read_stats(f), key, f));
-        }
-        return v;
-      };
-      const auto table = bbw::csv::read(out_dir + "/ccu_" + c.name + ".csv", bbw::launch::ccu_log_columns());
-      const auto m = bbw::launch::summarize_corner(c.name, table);
-      const std::string p = c.name + ".";
-      const long long pub = static_cast<long long>(corner_sum("samples_published"));
-      // Not receivable: still held back by an injected delay, or sent after the CCU died.
-      const long long in_flight =
-          static_cast<long long>(corner_sum("samples_in_flight") + corner_sum("samples_without_ccu"));
-      const long long rec = static_cast<long long>(num(ccu, p + "samples_received", ccu_stats_file));
-      // Measurement samples missing at the CCU, measurement block numbers skipped, and commands
-      // the corner never saw (realtime: a corner follows the newest, so only the first matters
-      // for "no sample lost"); sequence_gaps is their sum.
-      const long long sample_gaps = static_cast<long long>(num(ccu, p + "sample_gaps", ccu_stats_file));
-      const long long block_gaps = static_cast<long long>(num(ccu, p + "block_gaps", ccu_stats_file));
-      const long long command_gaps = static_cast<long long>(corner_sum("command_seq_gaps"));
-      const long long g = sample_gaps + block_gaps + command_gaps;
-      published += pub;
-      in_flight_total += in_flight;
-      received += rec;
-      gaps += g;
-      overruns += static_cast<long long>(corner_sum("overruns"));
-      cmd_deadlines += static_cast<long long>(corner_sum("command_deadlines_missed"));
-      max_jitter = std::max(max_jitter, corner_max("max_jitter_s"));
-      ccu_lost_s[c.name] = num(bbw::launch::read_stats(corner_stats_file(c.name, incarnations[c.name] - 1)), "ccu_lost_s",
-                               corner_stats_file(c.name, incarnations[c.name] - 1));
-      std::vector<std::pair<double, double>> period_rows;
-      {
-        bbw::csv::ReadOptions o;
-        o.required = {"time_s", "force_true_kN"};
-        const auto t = bbw::csv::read(out_dir + "/corner_" + c.name + "_periods.csv", o);
-        for (std::size_t r = 0; r < t.rows(); ++r) period_rows.emplace_back(t.column("time_s")[r], t.column("force_true_kN")[r]);
-      }
-      period_logs.push_back(std::move(period_rows));
-      j.begin_object()
-          .value("corner", c.name)
-          .value("temperature_C", c.conditions.temperature_C)
-          .value("estimate_max_abs_error_kN", m.fused_max_abs_error_kN)
-          .value("estimate_rms_error_kN", m.fused_rms_error_kN)
-          .value("compensated_load_cell_max_abs_error_kN", m.compensated_max_abs_error_kN)
-          .value("compensated_load_cell_rms_error_kN", m.compensated_rms_error_kN)
-          .value("raw_load_cell_rms_error_kN", m.load_cell_rms_error_kN)
-          .value("samples_scored", m.samples_scored)
-          .value("force_command_samples", m.force_samples)
-          .value("tracking_max_abs_error_kN", m.tracking_max_abs_error_kN)
-          .value("tracking_rms_error_kN", m.tracking_rms_error_kN)
-          .value("tracking_steady_max_abs_error_kN", m.tracking_steady_max_abs_error_kN)
-          .value("tracking_steady_rms_error_kN", m.tracking_steady_rms_error_kN)
-          .value("fits_accepted", static_cast<long long>(num(ccu, p + "fits_accepted", ccu_stats_file)))
-          .value("fits_rejected", static_cast<long long>(num(ccu, p + "fits_rejected", ccu_stats_file)))
-          .value("first_fit_time_s", num(ccu, p + "first_fit_time_s", ccu_stats_file))
-          .value("samples_published", pub)
-          .value("samples_received", rec)
-          .value("sequence_gaps", g)
-          .value("sample_gaps", sample_gaps)
-          .value("block_gaps", block_gaps)
-          .value("command_gaps", command_gaps)
-          .value("samples_suppressed_by_fault", static_cast<long long>(corner_sum("samples_suppressed")))
-          .value("samples_not_receivable", in_flight)
-          .value("incarnations", static_cast<long long>(incarnations[c.name]))
-          .value("rejoins", static_cast<long long>(num(ccu, p + "rejoins", ccu_stats_file)))
-          .value("samples_rejected_by_guard", static_cast<long long>(num(ccu, p + "guard_rejected", ccu_stats_file)))
-          .value("calibrator_restarts", static_cast<long long>(num(ccu, p + "calibrator_restarts", ccu_stats_file)))
-          .value("measurement_deadline_misses", static_cast<long long>(num(ccu, p + "deadlines_missed", ccu_stats_file)))
-          .value("measurement_liveliness_lost", static_cast<long long>(num(ccu, p + "liveliness_lost", ccu_stats_file)))
-          .value("command_deadline_misses", static_cast<long long>(corner_sum("command_deadlines_missed")))
-          .value("ccu_lost_detected_s", ccu_lost_s[c.name])
-          .value("max_jitter_s", corner_max("max_jitter_s"))
-          .value("mean_jitter_s", num(cs, "mean_jitter_s", cs_file))
-          .value("overruns", static_cast<long long>(corner_sum("overruns")))
-          .value("commands_clamped", static_cast<long long>(corner_sum("commands_clamped")))
-          .value("commands_refused_run", static_cast<long long>(corner_sum("commands_refused_run")))
-          .value("commands_refused_source", static_cast<long long>(corner_sum("commands_refused_source")))
-          .value("commands_refused_value", static_cast<long long>(corner_sum("commands_refused_value")))
-          .end_object();
-      bbw::launch::ReportCorner rc;
-      rc.summary = m;
-      rc.calibrated = num(ccu, p + "fits_accepted", ccu_stats_file) > 0;
-      rc.curve = {num(ccu, p + "curve_a", ccu_stats_file), num(ccu, p + "curve_b", ccu_stats_file),
-                  num(ccu, p + "curve_c", ccu_stats_file), num(ccu, p + "curve_d", ccu_stats_file)};
-      report_corners.push_back(rc);
-    }
-    j.end_array();
-    j.begin_object("run")
-        .value("mode", mode)
-        .value("simulated_s", sim_s)
-        .value("wall_s", wall_s)
-        .value("launch_wall_s", launch_wall_s)
-        .value("real_time_factor", wall_s > 0.0 ? sim_s / wall_s : 0.0)
-        .value("samples_published", published)
-        .value("samples_received", received)
-        .value("samples_lost", published - received - in_flight_total)
-        .value("ended_by_injected_ccu_kill", ccu_killed)
-        .value("sequence_gaps", gaps)
-        .value("measurement_deadline_misses", static_cast<long long>(num(ccu, "measurement_deadlines_missed", ccu_stats_file)))
-        .value("measurement_liveliness_lost", static_cast<long long>(num(ccu, "measurement_liveliness_lost", ccu_stats_file)))
-        .value("command_deadline_misses", cmd_deadlines)
-        .value("max_jitter_s", max_jitter)
-        .value("overruns", overruns)
-        .value("foreign_run_samples", static_cast<long long>(num(ccu, "foreign_run_samples", ccu_stats_file)))
-        .end_object();
-    // Injected faults against what was detected, and the total clamp force against demand.
-    const auto timeline = bbw::launch::build_timeline(*scenario, period_logs);
-    const auto detections = bbw::launch::read_detections(ccu, ccu_stats_file);
-    const auto faults = bbw::launch::assess_faults(schedule, detections, ccu_lost_s, timeline, scenario->duration_s);
-    j.begin_array("faults");
-    for (const auto& f : faults) {
-      j.begin_object()
-          .value("corner", std::string(bbw::faults::to_string(f.fault.target)))
-          .value("part", std::string(bbw::faults::to_string(f.fault.part)))
-          .value("type", std::string(bbw::faults::to_string(f.fault.type)))
-          .value("injected_s", f.fault.at_s)
-          .value("ends_s", std::min(f.fault.end_s(), scenario->duration_s))
-          .value("detected", f.detected)
-          .value("detected_s", f.detected ? f.detected_s : -1.0)
-          .value("latency_ms", f.detected ? f.latency_ms : -1.0)
-          .value("diagnosis", f.diagnosis)
-          .value("diagnosis_s", f.detected ? f.diagnosis_s : -1.0)
-          .value("diagnosis_latency_ms", f.detected ? f.diagnosis_latency_ms : -1.0)
-          .value("correct", f.correct)
-          .value("reaction", f.reaction)
-          .value("delivered_share", f.delivered_share)
-          .end_object();
-    }
-    j.end_array();
-    j.begin_array("detections");
-    for (const auto& d : detections) {
-      j.begin_object()
-          .value("corner", d.corner)
-          .value("part", d.part)
-          .value("finding", d.finding)
-          .value("onset_s", d.onset_s)
-          .value("detected_s", d.detected_s)
-          .end_object();
-    }
-    j.end_array();
-    j.end_object();
-    j.save(out_dir + "/summary.json");
-    {
-      std::ofstream tl(out_dir + "/timeline.csv");
-      tl << "time_s,demand_total_kN,delivered_total_kN\n";
-      for (const auto& p : timeline) tl << p.time_s << ',' << p.demand_kN << ',' << p.delivered_kN << '\n';
-      if (!tl) throw std::runtime_error(out_dir + "/timeline.csv: cannot write");
-    }
-    if (report) {
-      bbw::launch::write_report(out_dir, "bbw run: " + scenario->name + " (" + mode + ")", report_corners, j.str(),
-                                &faults, &detections);
-    }
-    std::cout << "bbw_launch: done: simulated " << sim_s << " s in " << wall_s << " s (real-time factor "
-              << (wall_s > 0 ? sim_s / wall_s : 0.0) << "), samples published " << published << ", received "
-              << received << ", gaps " << gaps << "; " << out_dir << "/summary.json" << std::endl;
+    bbw::launch::CompletedRun run;
+    run.scenario = &*scenario;
+    run.schedule = &schedule;
+    run.scenario_file = scenario_file;
+    run.mode = mode;
+    run.run_id = run_hex;
+    run.out_dir = out_dir;
+    run.friction_feedback = feedback;
+    run.domain = domain;
+    run.secure = secure;
+    run.report = report;
+    run.incarnations = incarnations;
+    run.ended_by_injected_ccu_kill = ccu_killed;
+    run.launch_wall_s = launch_wall_s;
+    const auto t = bbw::launch::write_run_summary(run);
+    std::cout << "bbw_launch: done: simulated " << t.simulated_s << " s in " << t.wall_s << " s (real-time factor "
+              << (t.wall_s > 0 ? t.simulated_s / t.wall_s : 0.0) << "), samples published " << t.published
+              << ", received " << t.received << ", gaps " << t.gaps << "; " << out_dir << "/summary.json" << std::endl;
   } catch (const std::exception& e) {
     std::cerr << "bbw_launch: summary failed: " << e.what() << "\n";
     return 1;

@@ -87,9 +87,15 @@ void write_report(const std::string& dir, const std::string& title, const std::v
   for (const auto& rc : corners) {
     const auto& m = rc.summary;
     char row[512];
+    char est[128];
+    if (m.samples_scored > 0) {
+      std::snprintf(est, sizeof(est), "%.3f / %.3f</td><td>%.3f", m.fused_max_abs_error_kN, m.fused_rms_error_kN,
+                    m.load_cell_rms_error_kN);
+    } else {
+      std::snprintf(est, sizeof(est), "(not scored)</td><td>(not scored)");
+    }
     std::snprintf(row, sizeof(row),
-                  "<tr><td>%s</td><td>%.3f / %.3f</td><td>%.3f</td><td>%s</td></tr>\n", m.corner.c_str(),
-                  m.fused_max_abs_error_kN, m.fused_rms_error_kN, m.load_cell_rms_error_kN,
+                  "<tr><td>%s</td><td>%s</td><td>%s</td></tr>\n", m.corner.c_str(), est,
                   m.force_samples > 0
                       ? (std::to_string(m.tracking_max_abs_error_kN).substr(0, 6) + " / " +
                          std::to_string(m.tracking_rms_error_kN).substr(0, 6)).c_str()
