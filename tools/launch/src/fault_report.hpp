@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "bbw/faults/outcome.hpp"
 #include "bbw/faults/schedule.hpp"
 #include "bbw/runtime/run_stats.hpp"
 #include "bbw/scenario/scenario.hpp"
@@ -28,20 +29,11 @@ struct TimelinePoint {
 std::vector<TimelinePoint> build_timeline(const scenario::Scenario& s,
                                           const std::vector<std::vector<std::pair<double, double>>>& period_logs);
 
-struct FaultResult {
-  faults::FaultSpec fault;
-  bool detected = false;
-  double detected_s = 0.0;        // first detection of anything on the faulty corner (CCU: first watchdog)
-  double latency_ms = 0.0;        // detected_s - injection
-  double diagnosis_s = 0.0;       // when the diagnosis below was made (the right part's, if any)
-  double diagnosis_latency_ms = 0.0;
-  std::string diagnosis = "none";
-  bool correct = false;
-  std::string reaction = "none";
-  double delivered_share = 1.0;  // delivered / demanded total while the fault lasted
-};
+// Scored by the one fault scorer (bbw/faults/outcome.hpp), shared with the closed-loop tests.
+using FaultResult = faults::FaultOutcome;
 
 // ccu_lost_s: per corner, the simulated time its watchdog found the CCU lost (< 0: never).
+// Throws std::runtime_error on a detection whose corner or finding bbw does not know.
 std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, const std::vector<Detection>& detections,
                                        const std::map<std::string, double>& ccu_lost_s,
                                        const std::vector<TimelinePoint>& timeline, double run_end_s);

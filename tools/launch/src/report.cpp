@@ -116,7 +116,7 @@ void write_report(const std::string& dir, const std::string& title, const std::v
                     faults::to_string(r.fault.target), faults::to_string(r.fault.part), faults::to_string(r.fault.type),
                     r.fault.at_s, r.detected ? std::to_string(r.detected_s).c_str() : "-",
                     r.detected ? std::to_string(r.latency_ms).substr(0, 6).c_str() : "-",
-                    html_escape(r.diagnosis).c_str(), r.correct ? "yes" : "no", html_escape(r.reaction).c_str(),
+                    html_escape(faults::diagnosis_name(r)).c_str(), r.correct ? "yes" : "no", html_escape(r.reaction).c_str(),
                     r.delivered_share);
       f << row;
     }

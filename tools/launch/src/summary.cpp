@@ -290,11 +290,11 @@ RunTotals write_run_summary(const CompletedRun& run) {
         .value("detected", f.detected)
         .value("detected_s", f.detected ? f.detected_s : -1.0)
         .value("latency_ms", f.detected ? f.latency_ms : -1.0)
-        .value("diagnosis", f.diagnosis)
+        .value("diagnosis", faults::diagnosis_name(f))
         .value("diagnosis_s", f.detected ? f.diagnosis_s : -1.0)
         .value("diagnosis_latency_ms", f.detected ? f.diagnosis_latency_ms : -1.0)
         .value("correct", f.correct)
-        .value("reaction", f.reaction)
+        .value("reaction", std::string(f.reaction))
         .value("delivered_share", f.delivered_share)
         .end_object();
   }
