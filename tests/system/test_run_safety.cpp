@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "bbw/launch/child.hpp"
+#include "bbw/runtime/child.hpp"
 #include "system_test_support.hpp"
 
 namespace {
@@ -43,7 +43,7 @@ std::vector<std::string> launch_argv(const std::string& scenario, const std::str
   return a;
 }
 
-std::string describe(const bbw::launch::ExitStatus& st, Launch& l) { return st.describe() + "\n" + l.out() + l.err(); }
+std::string describe(const bbw::runtime::ExitStatus& st, Launch& l) { return st.describe() + "\n" + l.out() + l.err(); }
 
 // Children of `pid` (from /proc), by their command name (comm).
 std::map<std::string, pid_t> children_of(pid_t pid) {

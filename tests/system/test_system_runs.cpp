@@ -17,8 +17,8 @@
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/calibration/offline.hpp"
 #include "bbw/common/csv.hpp"
-#include "bbw/launch/child.hpp"
-#include "bbw/launch/stats_file.hpp"
+#include "bbw/runtime/child.hpp"
+#include "bbw/runtime/stats_file.hpp"
 #include "system_test_support.hpp"
 
 namespace {
@@ -40,7 +40,7 @@ ProcessRun launch(const std::string& scenario, const std::string& dir, int domai
 }
 
 double stat(const std::string& file, const std::string& key) {
-  return bbw::launch::stat_number(bbw::launch::read_stats(file), key, file);
+  return bbw::runtime::stat_number(bbw::runtime::read_stats(file), key, file);
 }
 
 // Domain 160.

@@ -43,7 +43,7 @@
 #include "bbw/common/data_path.hpp"
 #include "bbw/dds/run_id.hpp"
 #include "bbw/dds/shm_cleanup.hpp"
-#include "bbw/launch/signals.hpp"
+#include "bbw/runtime/signals.hpp"
 #include "domain_claim.hpp"
 #include "options.hpp"
 #include "out_dir.hpp"
@@ -89,7 +89,7 @@ int write_partial(const bbw::launch::RunPlan& plan, const std::string& failure, 
 int main(int argc, char** argv) {
   // First, before any thread exists: SIGINT/SIGTERM go to the watcher only.
   std::atomic<int> stop_signal{0};
-  bbw::launch::SignalWatcher signals([&](int sig) { stop_signal.store(sig); });
+  bbw::runtime::SignalWatcher signals([&](int sig) { stop_signal.store(sig); });
 
   bbw::launch::Options opt;
   int domain = -1;

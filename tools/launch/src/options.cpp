@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 #include "bbw/dds/domain.hpp"
-#include "bbw/dds/process_cli.hpp"
+#include "bbw/runtime/process_cli.hpp"
 #include "bbw/faults/link_faults.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/scenario/load.hpp"
@@ -19,14 +19,14 @@ const char* const kUsage =
 
 Options parse_options(int argc, char** argv) {
   Options o;
-  for (dds::ArgCursor args(argc, argv); !args.done();) {
+  for (runtime::ArgCursor args(argc, argv); !args.done();) {
     const std::string k = args.flag();
     auto next = [&] { return args.value(); };
     if (k == "--out") o.out_dir = next();
-    else if (k == "--mode") dds::parse_clock_mode(o.mode = next());
+    else if (k == "--mode") runtime::parse_clock_mode(o.mode = next());
     else if (k == "--domain") o.domain_arg = next();
     else if (k == "--discovery-timeout") {
-      o.discovery_s = static_cast<double>(dds::seconds_arg(k, next(), 600.0).count()) / 1000.0;
+      o.discovery_s = static_cast<double>(runtime::seconds_arg(k, next(), 600.0).count()) / 1000.0;
     } else if (k == "--friction-feedback") o.friction_feedback = next();
     else if (k == "--no-report") o.report = false;
     else if (k == "--secure") o.secure = true;

@@ -119,7 +119,7 @@ Supervisor::Supervisor(RunPlan plan, const std::atomic<int>& stop_signal)
   bool corner_restarts = false;
   for (const auto& a : actions_) corner_restarts |= a.kind == faults::ProcessAction::Kind::Restart;
   if (corner_restarts) profile_args_ = {"--dds-participant-profile", "bbw_localhost_udp"};
-  bin_ = executable_dir();
+  bin_ = runtime::executable_dir();
   // Test hook: BBW_LAUNCH_CORNER_BIN replaces the corner executable (e.g. one that fails to
   // start), so the failure path is exercised with real processes.
   const char* corner_bin_env = std::getenv("BBW_LAUNCH_CORNER_BIN");
@@ -207,7 +207,7 @@ SupervisedRun Supervisor::run() {
     const auto wake = std::min(deadline, Clock::now() + (process_faults() ? 2ms : 200ms));
     std::vector<Child*> raw;
     for (auto& c : children_) raw.push_back(c.get());
-    wait_any(raw, wake);
+    runtime::wait_any(raw, wake);
     if (const int sig = stop_signal_.load(); sig != 0) {
       failure = "interrupted by " + signal_name(sig);
       break;

@@ -16,11 +16,15 @@
 
 #include "bbw/faults/link_faults.hpp"
 #include "bbw/faults/schedule.hpp"
-#include "bbw/launch/child.hpp"
+#include "bbw/runtime/child.hpp"
 #include "bbw/scenario/scenario.hpp"
 #include "partial_summary.hpp"
 
 namespace bbw::launch {
+
+using runtime::Child;
+using runtime::Clock;
+using runtime::ExitStatus;
 
 struct RunPlan {
   const scenario::Scenario* scenario = nullptr;
