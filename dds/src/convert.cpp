@@ -21,23 +21,6 @@ void to_msg(const scenario::CornerSample& in, bool force_comp_used, msg::Measure
   out.status(status);
 }
 
-calibration::Sample to_calibration_sample(const msg::MeasurementSample& in) {
-  calibration::Sample s;
-  s.time_s = in.time_s();
-  s.position_rev = in.position_rev();
-  s.force_kN = in.force_internal_kN();
-  return s;
-}
-
-bool is_finite(const msg::MeasurementSample& in) {
-  for (double v : {in.time_s(), in.position_rev(), in.speed_rev_s(), in.force_internal_kN(),
-                   in.force_external_kN(), in.force_true_kN(), in.temperature_C(),
-                   in.motor_current_A(), in.command()}) {
-    if (!std::isfinite(v)) return false;
-  }
-  return true;
-}
-
 void to_msg(const calibration::Calibrator& calibrator, std::uint8_t corner_id, std::uint64_t version,
             double time_s, msg::CalibrationState& out) {
   const auto& c = calibrator.curve();

@@ -106,7 +106,7 @@ TEST(CalibrateCli, SameNumbersAsTheLibrary) {
   bbw::csv::ReadOptions o;
   o.required = {"t", "x", "f_int", "f_ext"};
   const auto table = bbw::csv::read(csv.string(), o);
-  bbw::calibration::Recording rec{table.column("t"), table.column("x"), table.column("f_int"), table.column("f_ext"), {}};
+  bbw::calibration::Recording rec{table.column("t"), table.column("x"), table.column("f_int"), table.column("f_ext"), {}, {}};
   const auto cfg = bbw::calibration::load_config(std::string(BBW_SOURCE_DIR_FALLBACK) + "/config/calibrator/robust.yaml");
   const auto res = bbw::calibration::run_recording(cfg, rec);
   char expected[64];

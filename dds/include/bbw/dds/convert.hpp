@@ -13,12 +13,6 @@ namespace bbw::dds {
 // Corner side: one simulated step into a wire sample (truth flagged as simulation-only).
 void to_msg(const scenario::CornerSample& in, bool force_comp_used, msg::MeasurementSample& out);
 
-// CCU side: the calibrator's input from a wire sample.
-calibration::Sample to_calibration_sample(const msg::MeasurementSample& in);
-
-// A wire sample is usable when every number is finite (hostile-input checks extend this).
-bool is_finite(const msg::MeasurementSample& in);
-
 // CCU side: the calibrator's current model into a CalibrationState message.
 void to_msg(const calibration::Calibrator& calibrator, std::uint8_t corner_id, std::uint64_t version,
             double time_s, msg::CalibrationState& out);
