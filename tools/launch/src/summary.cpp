@@ -108,8 +108,15 @@ std::string tracking_not_scored_reason(const CornerSummary& s) {
 
 namespace bbw::launch {
 
+std::string incarnation_suffix(unsigned n) {
+  if (n == 0) return "";
+  std::string s(1, '.');  // built by append: GCC 12 warns (-Wrestrict, a false positive) on "." + string
+  s.append(std::to_string(n));
+  return s;
+}
+
 std::string corner_stats_file(const std::string& out_dir, const std::string& corner, unsigned n) {
-  return out_dir + "/corner_" + corner + (n == 0 ? "" : "." + std::to_string(n)) + ".stats";
+  return out_dir + "/corner_" + corner + incarnation_suffix(n) + ".stats";
 }
 
 RunTotals write_run_summary(const CompletedRun& run) {

@@ -59,7 +59,9 @@ struct CompletedRun {
   double launch_wall_s = 0.0;
 };
 
-// OUT/<name>.stats of a corner's incarnation n (0: the first process).
+// "" for a corner's first process, ".<n>" for its incarnation n (file and process names).
+std::string incarnation_suffix(unsigned n);
+// OUT/corner_<C>[.<n>].stats of a corner's incarnation n (0: the first process).
 std::string corner_stats_file(const std::string& out_dir, const std::string& corner, unsigned incarnation);
 
 // The totals the launcher prints at the end.

@@ -15,6 +15,7 @@
 
 #include "bbw/common/data_path.hpp"
 #include "bbw/security/dds_security.hpp"
+#include "summary.hpp"
 
 namespace bbw::launch {
 
@@ -133,7 +134,7 @@ Supervisor::~Supervisor() {
 }
 
 void Supervisor::spawn_corner(const std::string& c, unsigned incarnation, double resume_at_s) {
-  const std::string suffix = incarnation == 0 ? "" : "." + std::to_string(incarnation);
+  const std::string suffix = incarnation_suffix(incarnation);
   std::vector<std::string> args{corner_bin_, "--corner", c, "--scenario", plan_.scenario_file, "--domain",
                                 std::to_string(plan_.domain), "--run-id", plan_.run_id, "--mode", plan_.mode,
                                 "--stats", plan_.out_dir + "/corner_" + c + suffix + ".stats",
