@@ -3,7 +3,9 @@
 // Domains 200-211, one per test (noted per test); runs that share a domain do so on purpose.
 // Every process is bounded (launcher wall-time bound, waits with deadlines); nothing sleeps.
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -301,6 +303,34 @@ void stop_before_start(int sig, const std::string& name) {
 }
 
 TEST(SystemStops, SigtermWhileKeysAreCreatedKeepsAPartialSummaryAndExits143) { stop_before_start(SIGTERM, "keys_sigterm"); }
+
+// Domain 211 (never joined): a launcher waiting for another launcher's lock on the keys folder
+// (here held by the test) is stopped the same way.
+TEST(SystemStops, SigtermWhileWaitingForTheKeysLockKeepsAPartialSummaryAndExits143) {
+  const std::string dir = scratch("keys_lock");
+  const std::string keys = dir + "/keys";
+  const std::string lock = "/tmp/bbw-keys-" + std::to_string(std::hash<std::string>{}(keys)) + ".lock";
+  const int fd = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  ASSERT_GE(fd, 0) << lock;
+  ASSERT_EQ(::flock(fd, LOCK_EX), 0) << lock;
+  Launch l(dir, "bbw_launch",
+           launch_argv("tests/system/data/long_stop.yaml", dir + "/out", "lockstep", 211, {"--secure", "--keys", keys}));
+  // The output folder is prepared before the keys are looked at: wait for it (bounded).
+  const auto end = Clock::now() + 30s;
+  while (!fs::exists(dir + "/out") && Clock::now() < end && !l.ended_within(20ms)) {
+  }
+  ASSERT_FALSE(l.ended_within(200ms)) << "the launcher did not wait for the lock\n" << l.out() << l.err();
+  l.signal(SIGTERM);
+  const auto st = l.wait(30s);
+  ::close(fd);
+  EXPECT_TRUE(st.exited && st.code == 128 + SIGTERM) << describe(st, l);
+  const std::string j = slurp(dir + "/out/summary.json");
+  ASSERT_FALSE(j.empty()) << "no summary after a stop while waiting for the keys lock\n" << l.err();
+  EXPECT_EQ(field(j, "interrupted"), "true") << j;
+  EXPECT_NE(field(j, "failure").find("before the run's processes started"), std::string::npos) << j;
+  EXPECT_FALSE(fs::exists(dir + "/out/keys.out")) << "the key script ran without the lock";
+  fs::remove_all(dir);
+}
 TEST(SystemStops, SigintWhileKeysAreCreatedKeepsAPartialSummaryAndExits130) { stop_before_start(SIGINT, "keys_sigint"); }
 
 // Domain 206 (the killed run) and 207 (the next launch): a SIGKILLed CCU still yields a summary

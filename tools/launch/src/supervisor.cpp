@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <thread>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -58,16 +60,24 @@ KeysResult ensure_keys(const std::string& keys_dir, const std::string& out_dir, 
   // One launcher at a time checks and creates the keys of a directory (two runs started at
   // once must not both write it): an flock on a lock file named after it, held until here ends.
   const std::string keys_lock = "/tmp/bbw-keys-" + std::to_string(std::hash<std::string>{}(keys_dir)) + ".lock";
+  // The wait for another launcher's lock is a poll, so a stop signal still ends it.
   const int keys_lock_fd = ::open(keys_lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
-  if (keys_lock_fd < 0 || ::flock(keys_lock_fd, LOCK_EX) != 0) {
-    if (keys_lock_fd >= 0) ::close(keys_lock_fd);
-    error = "cannot lock " + keys_lock + " for the keys in " + keys_dir;
+  if (keys_lock_fd < 0) {
+    error = "cannot open " + keys_lock + " for the keys in " + keys_dir;
     return KeysResult::Failed;
   }
   struct CloseLock {
     int fd;
     ~CloseLock() { ::close(fd); }
   } close_keys_lock{keys_lock_fd};
+  while (::flock(keys_lock_fd, LOCK_EX | LOCK_NB) != 0) {
+    if (errno != EWOULDBLOCK && errno != EINTR) {
+      error = "cannot lock " + keys_lock + " for the keys in " + keys_dir;
+      return KeysResult::Failed;
+    }
+    if (stop_signal.load() != 0) return KeysResult::Interrupted;
+    std::this_thread::sleep_for(50ms);
+  }
   auto check_keys = [&]() -> std::string {
     try {
       for (const auto& id : security::identities()) security::files_for(keys_dir, id);
