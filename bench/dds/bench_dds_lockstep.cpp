@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "bbw/launch/child.hpp"
-#include "bbw/launch/stats_file.hpp"
+#include "bbw/runtime/child.hpp"
+#include "bbw/runtime/stats_file.hpp"
 
 namespace {
 
@@ -31,22 +31,22 @@ void lockstep_rig(benchmark::State& state, bool secure) {
   for (auto _ : state) {
     std::filesystem::remove_all(out);
     std::filesystem::create_directories(out);
-    std::vector<std::string> argv{bbw::launch::executable_dir() + "/bbw_launch",
+    std::vector<std::string> argv{bbw::runtime::executable_dir() + "/bbw_launch",
                                   std::string(BBW_SOURCE_DIR) + "/config/scenarios/four_corner_rig.yaml", "--out",
                                   out + "/out", "--mode", "lockstep", "--domain", domain, "--no-report"};
     if (secure) {
       const char* keys = std::getenv("BBW_BENCH_KEYS");
       argv.insert(argv.end(), {"--secure", "--keys", keys && *keys ? keys : std::string(BBW_SOURCE_DIR) + "/keys"});
     }
-    bbw::launch::Child launch("bbw_launch", argv, out + "/launch.out", out + "/launch.err");
+    bbw::runtime::Child launch("bbw_launch", argv, out + "/launch.out", out + "/launch.err");
     const auto status = launch.wait_until(std::chrono::steady_clock::now() + 300s);
     if (!status || !status->ok()) {
       state.SkipWithError("bbw_launch failed; see /tmp/bbw_bench_lockstep/launch.err");
       return;
     }
-    const auto s = bbw::launch::read_stats(stats);
-    const double wall = bbw::launch::stat_number(s, "wall_s", stats);
-    const double sim = bbw::launch::stat_number(s, "sim_s", stats);
+    const auto s = bbw::runtime::read_stats(stats);
+    const double wall = bbw::runtime::stat_number(s, "wall_s", stats);
+    const double sim = bbw::runtime::stat_number(s, "sim_s", stats);
     state.SetIterationTime(wall);
     rtf_sum += sim / wall;
     rtf_min = std::min(rtf_min, sim / wall);

@@ -27,7 +27,7 @@
 #include "bbw/dds/reader.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/dds/writer.hpp"
-#include "bbw/launch/child.hpp"
+#include "bbw/runtime/child.hpp"
 #include "bbw/security/dds_security.hpp"
 
 namespace {
@@ -50,7 +50,7 @@ std::string bench_keys(std::string& error) {
   } catch (const bbw::security::SecurityError&) {
   }
   const std::string log = std::filesystem::temp_directory_path() / "bbw_bench_keys";
-  bbw::launch::Child keys("bbw-keys.sh", {std::string(BBW_SOURCE_DIR) + "/scripts/bbw-keys.sh", dir}, log + ".out",
+  bbw::runtime::Child keys("bbw-keys.sh", {std::string(BBW_SOURCE_DIR) + "/scripts/bbw-keys.sh", dir}, log + ".out",
                           log + ".err");
   const auto st = keys.wait_until(Clock::now() + 120s);
   if (!st || !st->ok()) {
@@ -71,10 +71,10 @@ void roundtrip(benchmark::State& state, bool lockstep_profiles, bool secure) {
     state.SkipWithError(keys_error.c_str());
     return;
   }
-  std::vector<std::string> echo_argv{bbw::launch::executable_dir() + "/bbw_dds_echo", "--domain",
+  std::vector<std::string> echo_argv{bbw::runtime::executable_dir() + "/bbw_dds_echo", "--domain",
                                      std::to_string(domain), "--mode", mode, "--partition", "corner_*"};
   if (secure) echo_argv.insert(echo_argv.end(), {"--secure", keys});
-  bbw::launch::Child echo("bbw_dds_echo", echo_argv, log_dir + "/echo.out", log_dir + "/echo.err");
+  bbw::runtime::Child echo("bbw_dds_echo", echo_argv, log_dir + "/echo.out", log_dir + "/echo.err");
   bbw::dds::Events events;
   bbw::dds::ParticipantOptions opt;
   opt.domain_id = domain;

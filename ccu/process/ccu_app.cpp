@@ -9,7 +9,7 @@
 #include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/faults/link_faults.hpp"
-#include "bbw/launch/stats_file.hpp"
+#include "bbw/runtime/run_stats.hpp"
 #include "bbw/node/csv_log.hpp"
 #include "bbw/security/dds_security.hpp"
 
@@ -272,78 +272,64 @@ int CcuApp::run(std::string& error) {
 }
 
 void CcuApp::write_stats(const std::string& file) const {
-  launch::StatsWriter w;
-  w.set("mode", std::string(options_.mode == ClockMode::Lockstep ? "lockstep" : "realtime"));
-  w.set("periods_planned", static_cast<unsigned long long>(periods_));
-  w.set("periods_done", static_cast<unsigned long long>(periods_done_));
-  w.set("sim_s", sim_s_);
-  w.set("wall_s", wall_s_);
-  w.set("killed_at_s", kill_at_s_ ? sim_s_ : -1.0);
-  std::uint64_t deadlines = 0, liveliness = 0, lost = 0, dropped = 0, foreign = 0;
+  runtime::CcuRunStats s;
+  s.mode = options_.mode == ClockMode::Lockstep ? "lockstep" : "realtime";
+  s.periods_planned = periods_;
+  s.periods_done = periods_done_;
+  s.sim_s = sim_s_;
+  s.wall_s = wall_s_;
+  s.killed_at_s = kill_at_s_ ? sim_s_ : -1.0;
   for (const auto& r : blocks_) {
-    deadlines += r->get().deadlines_missed();
-    liveliness += r->get().liveliness_lost();
-    lost += r->get().samples_lost();
-    dropped += r->get().events_dropped();
+    s.measurement_deadlines_missed += r->get().deadlines_missed();
+    s.measurement_liveliness_lost += r->get().liveliness_lost();
+    s.measurement_samples_lost += r->get().samples_lost();
+    s.qos_events_dropped += r->get().events_dropped();
   }
-  for (std::size_t i = 0; i < node_.channels(); ++i) foreign += node_.channel(i).foreign_blocks + node_.channel(i).foreign_health;
-  w.set("measurement_deadlines_missed", static_cast<unsigned long long>(deadlines));
-  w.set("measurement_liveliness_lost", static_cast<unsigned long long>(liveliness));
-  w.set("measurement_samples_lost", static_cast<unsigned long long>(lost));
-  w.set("qos_events_dropped", static_cast<unsigned long long>(dropped));
-  w.set("foreign_corner_samples", static_cast<unsigned long long>(foreign));
-  w.set("unknown_corner_blocks", static_cast<unsigned long long>(node_.unknown_corner_blocks()));
-  w.set("foreign_run_samples", static_cast<unsigned long long>(node_.foreign_run_samples()));
-  w.set("foreign_runs", dds::join_peer_tags(participant_.foreign_runs()));
-  std::uint64_t command_failures = 0;
-  for (const auto& c : commands_) command_failures += c->get().write_failures();
-  w.set("command_write_failures", static_cast<unsigned long long>(command_failures));
-  std::string corners;
-  for (std::size_t i = 0; i < node_.channels(); ++i) corners += (corners.empty() ? "" : ",") + std::string(corner_name(node_.channel(i).corner));
-  w.set("corners", corners);
+  for (std::size_t i = 0; i < node_.channels(); ++i) {
+    s.foreign_corner_samples += node_.channel(i).foreign_blocks + node_.channel(i).foreign_health;
+  }
+  s.unknown_corner_blocks = node_.unknown_corner_blocks();
+  s.foreign_run_samples = node_.foreign_run_samples();
+  s.foreign_runs = dds::join_peer_tags(participant_.foreign_runs());
+  for (const auto& c : commands_) s.command_write_failures += c->get().write_failures();
   for (std::size_t i = 0; i < node_.channels(); ++i) {
     const node::CornerChannel& ch = node_.channel(i);
-    const std::string p = std::string(corner_name(ch.corner)) + ".";
     const faults::CornerSupervisor& sup = node_.core().supervisor(ch.slot);
     const auto& st = sup.calibrator().stats();
-    w.set(p + "blocks_received", static_cast<unsigned long long>(ch.blocks_received));
-    w.set(p + "samples_received", static_cast<unsigned long long>(ch.samples_received));
-    w.set(p + "samples_invalid", static_cast<unsigned long long>(ch.samples_invalid));
-    w.set(p + "foreign_blocks", static_cast<unsigned long long>(ch.foreign_blocks));
-    w.set(p + "foreign_health", static_cast<unsigned long long>(ch.foreign_health));
-    w.set(p + "blocks_over_rate", static_cast<unsigned long long>(ch.blocks_over_rate));
-    w.set(p + "block_gaps", static_cast<unsigned long long>(ch.block_gaps));
-    w.set(p + "sample_gaps", static_cast<unsigned long long>(ch.sample_gaps));
-    w.set(p + "rejoins", static_cast<unsigned long long>(ch.rejoins));
-    w.set(p + "deadlines_missed", static_cast<unsigned long long>(ch.deadlines_missed));
-    w.set(p + "liveliness_lost", static_cast<unsigned long long>(ch.liveliness_lost));
-    w.set(p + "guard_rejected", static_cast<unsigned long long>(sup.guard().rejected()));
-    w.set(p + "calibrator_restarts", static_cast<unsigned long long>(sup.calibrator_restarts()));
-    w.set(p + "fits_accepted", static_cast<unsigned long long>(st.fits_accepted));
-    w.set(p + "fits_rejected", static_cast<unsigned long long>(st.fits_rejected));
-    w.set(p + "cycles_detected", static_cast<unsigned long long>(st.cycles_detected));
-    w.set(p + "samples_rejected", static_cast<unsigned long long>(st.samples_rejected));
-    w.set(p + "first_fit_time_s", st.first_fit_time_s);
-    w.set(p + "calibration_version", static_cast<unsigned long long>(ch.calibration_version));
-    const auto& c = sup.calibrator().curve();
-    w.set(p + "curve_a", c.a);
-    w.set(p + "curve_b", c.b);
-    w.set(p + "curve_c", c.c);
-    w.set(p + "curve_d", c.d);
+    runtime::CcuCornerStats c;
+    c.corner = std::string(corner_name(ch.corner));
+    c.blocks_received = ch.blocks_received;
+    c.samples_received = ch.samples_received;
+    c.samples_invalid = ch.samples_invalid;
+    c.foreign_blocks = ch.foreign_blocks;
+    c.foreign_health = ch.foreign_health;
+    c.blocks_over_rate = ch.blocks_over_rate;
+    c.block_gaps = ch.block_gaps;
+    c.sample_gaps = ch.sample_gaps;
+    c.rejoins = ch.rejoins;
+    c.deadlines_missed = ch.deadlines_missed;
+    c.liveliness_lost = ch.liveliness_lost;
+    c.guard_rejected = sup.guard().rejected();
+    c.calibrator_restarts = sup.calibrator_restarts();
+    c.fits_accepted = st.fits_accepted;
+    c.fits_rejected = st.fits_rejected;
+    c.cycles_detected = st.cycles_detected;
+    c.samples_rejected = st.samples_rejected;
+    c.first_fit_time_s = st.first_fit_time_s;
+    c.calibration_version = ch.calibration_version;
+    const auto& curve = sup.calibrator().curve();
+    c.curve_a = curve.a;
+    c.curve_b = curve.b;
+    c.curve_c = curve.c;
+    c.curve_d = curve.d;
+    s.corners.push_back(c);
   }
   // Every detection in time order of recording: corner, finding, onset, detection time.
-  const auto& detections = node_.detections();
-  w.set("detections", static_cast<unsigned long long>(detections.size()));
-  for (std::size_t i = 0; i < detections.size(); ++i) {
-    const node::DetectionRecord& d = detections[i];
-    const std::string p = "detection." + std::to_string(i) + ".";
-    w.set(p + "corner", std::string(corner_name(static_cast<Corner>(d.slot))));
-    w.set(p + "finding", std::string(faults::to_string(d.finding)));
-    w.set(p + "part", std::string(faults::to_string(faults::part_of(d.finding))));
-    w.set(p + "onset_s", d.onset_s);
-    w.set(p + "detected_s", d.detected_s);
+  for (const node::DetectionRecord& d : node_.detections()) {
+    s.detections.push_back({std::string(corner_name(static_cast<Corner>(d.slot))), std::string(faults::to_string(d.finding)),
+                            std::string(faults::to_string(faults::part_of(d.finding))), d.onset_s, d.detected_s});
   }
-  w.save(file);
+  runtime::save(s, file);
 }
 
 }  // namespace bbw::ccu

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "bbw/calibration/calibrator.hpp"
-#include "bbw/dds/process_cli.hpp"
+#include "bbw/runtime/process_cli.hpp"
 #include "bbw/dds/corner.hpp"
 #include "bbw/dds/events.hpp"
 #include "bbw/dds/participant.hpp"
@@ -29,20 +29,20 @@
 
 namespace bbw::ccu {
 
-using dds::ClockMode;
+using runtime::ClockMode;
 
-using dds::ExitCode;
-using dds::kExitDiscovery;
-using dds::kExitOk;
-using dds::kExitPeerLost;
-using dds::kExitRuntime;
-using dds::kExitUsage;
+using runtime::ExitCode;
+using runtime::kExitDiscovery;
+using runtime::kExitOk;
+using runtime::kExitPeerLost;
+using runtime::kExitRuntime;
+using runtime::kExitUsage;
 
-// Mode, participant, timeouts and process_faults from dds::ProcessOptions. With
+// Mode, participant, timeouts and process_faults from runtime::ProcessOptions. With
 // process_faults the CCU freezes itself (SIGSTOP) at its scheduled kill time for the launcher to
 // SIGKILL it, and in lockstep holds the clock at a corner's scheduled restart until the new
 // process has joined.
-struct CcuOptions : dds::ProcessOptions {
+struct CcuOptions : runtime::ProcessOptions {
   std::string out_dir;                            // per-corner CSVs and ccu.stats; "" for none
   bool friction_feedback = true;                  // let corners use compensated feedback
   faults::MonitorParams monitor;                  // config/faults/monitor.yaml (--monitor)

@@ -6,7 +6,7 @@
 //           [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--secure KEYS_DIR]
 //           [--out DIR] [--calibrator FILE.yaml] [--monitor FILE.yaml] [--friction-feedback on|off]
 //
-// The flags in the first three lines are bbw_corner's too (bbw/dds/process_cli.hpp).
+// The flags in the first three lines are bbw_corner's too (bbw/runtime/process_cli.hpp).
 //
 // --secure: DDS Security with the CCU's identity from KEYS_DIR (`./bbw keys KEYS_DIR`,
 // docs/security.md); a missing key file is a configuration error (exit 2).
@@ -26,10 +26,10 @@
 
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/common/data_path.hpp"
-#include "bbw/dds/process_cli.hpp"
+#include "bbw/runtime/process_cli.hpp"
 #include "bbw/faults/monitor_yaml.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
-#include "bbw/launch/signals.hpp"
+#include "bbw/runtime/signals.hpp"
 #include "bbw/scenario/load.hpp"
 #include "bbw/security/dds_security.hpp"
 #include "ccu_app.hpp"
@@ -37,7 +37,7 @@
 namespace {
 
 std::string usage() {
-  return bbw::dds::process_usage("bbw_ccu", "", {"[--out DIR] [--calibrator FILE.yaml] [--monitor FILE.yaml] [--friction-feedback on|off]"});
+  return bbw::runtime::process_usage("bbw_ccu", "", {"[--out DIR] [--calibrator FILE.yaml] [--monitor FILE.yaml] [--friction-feedback on|off]"});
 }
 
 }  // namespace
@@ -45,14 +45,14 @@ std::string usage() {
 int main(int argc, char** argv) {
   using namespace bbw::ccu;
   bbw::dds::Events events;
-  bbw::launch::SignalWatcher signals([&](int) { events.interrupt(); });
+  bbw::runtime::SignalWatcher signals([&](int) { events.interrupt(); });
 
   CcuOptions opt;
-  bbw::dds::ProcessFlags flags;
+  bbw::runtime::ProcessFlags flags;
   std::string calibrator_file;  // default: config/calibrator/robust.yaml of bbw's data (bbw/common/data_path.hpp)
   std::string monitor_file;     // default: config/faults/monitor.yaml
   try {
-    for (bbw::dds::ArgCursor args(argc, argv); !args.done();) {
+    for (bbw::runtime::ArgCursor args(argc, argv); !args.done();) {
       const std::string k = args.flag();
       if (flags.take(k, args)) continue;
       if (k == "--out") opt.out_dir = args.value();
@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
     std::cerr << "bbw_ccu: " << e.what() << "\n" << usage();
     return kExitUsage;
   }
-  static_cast<bbw::dds::ProcessOptions&>(opt) = flags.options;
+  static_cast<bbw::runtime::ProcessOptions&>(opt) = flags.options;
   const std::string& secure_dir = flags.secure_dir;
   const std::string& scenario_file = flags.scenario_file;
 

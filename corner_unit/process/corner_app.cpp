@@ -12,7 +12,7 @@
 
 #include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
-#include "bbw/launch/stats_file.hpp"
+#include "bbw/runtime/run_stats.hpp"
 #include "bbw/node/csv_log.hpp"
 
 namespace bbw::corner_process {
@@ -229,39 +229,39 @@ int CornerApp::run(std::string& error) {
 }
 
 void CornerApp::write_stats(const std::string& file) const {
-  const CornerStats& s = node_.stats();
-  launch::StatsWriter w;
-  w.set("corner", std::string(dds::corner_name(options_.corner)));
-  w.set("incarnation", static_cast<unsigned long long>(options_.incarnation));
-  w.set("first_step", static_cast<unsigned long long>(s.first_step));
-  w.set("periods", s.periods);
-  w.set("samples_published", s.samples_published);
-  w.set("blocks_published", s.blocks_published);
-  w.set("write_failures", s.write_failures);
-  w.set("commands_received", s.commands_received);
-  w.set("commands_applied", s.commands_applied);
-  w.set("command_seq_gaps", s.command_seq_gaps);
-  w.set("calibrations_applied", s.calibrations_applied);
-  w.set("calibrations_rejected", s.calibrations_rejected);
-  w.set("overruns", s.overruns);
-  w.set("max_jitter_s", s.max_jitter_s);
-  w.set("mean_jitter_s", s.mean_jitter_s);
-  w.set("command_deadlines_missed", s.command_deadlines_missed);
-  w.set("samples_suppressed", s.samples_suppressed);
-  w.set("samples_delayed", s.samples_delayed);
-  w.set("samples_in_flight", s.samples_in_flight);
-  w.set("samples_without_ccu", s.samples_without_ccu);
-  w.set("ccu_lost_s", s.ccu_lost_s);
-  w.set("default_force_s", s.default_force_s);
-  w.set("wall_s", s.wall_s);
+  const CornerStats& n = node_.stats();
+  runtime::CornerRunStats s;
+  s.corner = std::string(dds::corner_name(options_.corner));
+  s.incarnation = options_.incarnation;
+  s.first_step = n.first_step;
+  s.periods = n.periods;
+  s.samples_published = n.samples_published;
+  s.blocks_published = n.blocks_published;
+  s.write_failures = n.write_failures;
+  s.commands_received = n.commands_received;
+  s.commands_applied = n.commands_applied;
+  s.command_seq_gaps = n.command_seq_gaps;
+  s.calibrations_applied = n.calibrations_applied;
+  s.calibrations_rejected = n.calibrations_rejected;
+  s.overruns = n.overruns;
+  s.max_jitter_s = n.max_jitter_s;
+  s.mean_jitter_s = n.mean_jitter_s;
+  s.command_deadlines_missed = n.command_deadlines_missed;
+  s.samples_suppressed = n.samples_suppressed;
+  s.samples_delayed = n.samples_delayed;
+  s.samples_in_flight = n.samples_in_flight;
+  s.samples_without_ccu = n.samples_without_ccu;
+  s.ccu_lost_s = n.ccu_lost_s;
+  s.default_force_s = n.default_force_s;
+  s.wall_s = n.wall_s;
   const corner::CommandGateCounts& g = node_.gate().counts();
-  w.set("commands_clamped", static_cast<unsigned long long>(g.clamped));
-  w.set("commands_refused_run", static_cast<unsigned long long>(g.refused_run));
-  w.set("commands_refused_source", static_cast<unsigned long long>(g.refused_source));
-  w.set("commands_refused_value", static_cast<unsigned long long>(g.refused_value));
-  w.set("gate_max_force_kN", node_.gate().params().max_force_kN);
-  w.set("foreign_runs", dds::join_peer_tags(participant_.foreign_runs()));
-  w.save(file);
+  s.commands_clamped = g.clamped;
+  s.commands_refused_run = g.refused_run;
+  s.commands_refused_source = g.refused_source;
+  s.commands_refused_value = g.refused_value;
+  s.gate_max_force_kN = node_.gate().params().max_force_kN;
+  s.foreign_runs = dds::join_peer_tags(participant_.foreign_runs());
+  runtime::save(s, file);
 }
 
 }  // namespace bbw::corner_process

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "bbw/dds/process_cli.hpp"
+#include "bbw/runtime/process_cli.hpp"
 #include "bbw/dds/convert.hpp"
 #include "bbw/dds/corner.hpp"
 #include "bbw/dds/events.hpp"
@@ -32,10 +32,10 @@
 
 namespace bbw::corner_process {
 
-using dds::ClockMode;
+using runtime::ClockMode;
 
-// Mode, participant, timeouts and process_faults from dds::ProcessOptions.
-struct CornerOptions : dds::ProcessOptions {
+// Mode, participant, timeouts and process_faults from runtime::ProcessOptions.
+struct CornerOptions : runtime::ProcessOptions {
   dds::Corner corner = dds::Corner::FL;
   std::size_t scenario_index = 0;               // the corner's index in the scenario
   // Longest wait for the CCU's endpoints to match (0: discovery_timeout). With DDS Security
@@ -59,12 +59,12 @@ struct CornerOptions : dds::ProcessOptions {
 };
 
 // Exit statuses (docs/distributed.md).
-using dds::ExitCode;
-using dds::kExitDiscovery;
-using dds::kExitOk;
-using dds::kExitPeerLost;
-using dds::kExitRuntime;
-using dds::kExitUsage;
+using runtime::ExitCode;
+using runtime::kExitDiscovery;
+using runtime::kExitOk;
+using runtime::kExitPeerLost;
+using runtime::kExitRuntime;
+using runtime::kExitUsage;
 
 using CornerStats = node::CornerStats;
 
@@ -81,7 +81,7 @@ class CornerApp {
   int run(std::string& error);
   const CornerStats& stats() const { return node_.stats(); }
   bool matched_ccu() const { return matched_ccu_; }  // the CCU's endpoints matched at least once
-  void write_stats(const std::string& file) const;  // key=value (bbw/launch/stats_file.hpp)
+  void write_stats(const std::string& file) const;  // key=value (bbw/runtime/run_stats.hpp)
 
  private:
   bool wait_for_ccu(std::string& error);

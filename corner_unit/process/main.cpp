@@ -5,7 +5,7 @@
 //              [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--secure KEYS_DIR]
 //              [--stats FILE] [--periods-log FILE] [--incarnation N --resume-at S]
 //
-// The flags from --scenario to --secure are bbw_ccu's too (bbw/dds/process_cli.hpp).
+// The flags from --scenario to --secure are bbw_ccu's too (bbw/runtime/process_cli.hpp).
 //
 // --secure: DDS Security with this corner's identity from KEYS_DIR (`./bbw keys KEYS_DIR`,
 // docs/security.md); a missing key file is a configuration error (exit 2).
@@ -28,10 +28,10 @@
 #include <string>
 
 #include "bbw/common/strict_yaml.hpp"
-#include "bbw/dds/process_cli.hpp"
+#include "bbw/runtime/process_cli.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
-#include "bbw/launch/signals.hpp"
-#include "bbw/launch/stats_file.hpp"
+#include "bbw/runtime/signals.hpp"
+#include "bbw/runtime/stats_file.hpp"
 #include "bbw/scenario/load.hpp"
 #include "bbw/security/dds_security.hpp"
 #include "corner_app.hpp"
@@ -39,7 +39,7 @@
 namespace {
 
 std::string usage() {
-  return bbw::dds::process_usage("bbw_corner", "--corner FL|FR|RL|RR",
+  return bbw::runtime::process_usage("bbw_corner", "--corner FL|FR|RL|RR",
                                 {"[--stats FILE] [--periods-log FILE] [--incarnation N --resume-at S]"});
 }
 
@@ -48,13 +48,13 @@ std::string usage() {
 int main(int argc, char** argv) {
   using namespace bbw::corner_process;
   bbw::dds::Events events;
-  bbw::launch::SignalWatcher signals([&](int) { events.interrupt(); });
+  bbw::runtime::SignalWatcher signals([&](int) { events.interrupt(); });
 
   CornerOptions opt;
-  bbw::dds::ProcessFlags flags;
+  bbw::runtime::ProcessFlags flags;
   std::string corner_arg;
   try {
-    for (bbw::dds::ArgCursor args(argc, argv); !args.done();) {
+    for (bbw::runtime::ArgCursor args(argc, argv); !args.done();) {
       const std::string k = args.flag();
       if (flags.take(k, args)) continue;
       if (k == "--corner") corner_arg = args.value();
@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
     std::cerr << "bbw_corner: " << e.what() << "\n" << usage();
     return kExitUsage;
   }
-  static_cast<bbw::dds::ProcessOptions&>(opt) = flags.options;
+  static_cast<bbw::runtime::ProcessOptions&>(opt) = flags.options;
   const std::string& secure_dir = flags.secure_dir;
   const std::string& scenario_file = flags.scenario_file;
 

@@ -20,12 +20,12 @@
 #include "bbw/dds/reader.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/dds/writer.hpp"
-#include "bbw/launch/signals.hpp"
+#include "bbw/runtime/signals.hpp"
 #include "bbw/security/dds_security.hpp"
 
 int main(int argc, char** argv) {
   bbw::dds::Events events;
-  bbw::launch::SignalWatcher signals([&](int) { events.interrupt(); });
+  bbw::runtime::SignalWatcher signals([&](int) { events.interrupt(); });
   std::optional<std::string> domain_arg;
   std::string mode = "realtime";
   long long max_blocks = -1;

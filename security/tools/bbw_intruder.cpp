@@ -50,7 +50,7 @@
 #include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/dds/writer.hpp"
-#include "bbw/launch/signals.hpp"
+#include "bbw/runtime/signals.hpp"
 #include "bbw/security/dds_security.hpp"
 
 namespace {
@@ -226,7 +226,7 @@ int main(int argc, char** argv) {
   // SIGINT/SIGTERM end the attempt early, still with its JSON line (tests stop an intruder
   // when the run it attacked is over).
   bbw::dds::Events events;
-  bbw::launch::SignalWatcher signals([&](int) { events.interrupt(); });
+  bbw::runtime::SignalWatcher signals([&](int) { events.interrupt(); });
   Options o;
   try {
     o = parse(argc, argv);

@@ -1,4 +1,4 @@
-// The flags bbw_ccu and bbw_corner share (dds/include/bbw/dds/process_cli.hpp): each is taken
+// The flags bbw_ccu and bbw_corner share (runtime/include/bbw/runtime/process_cli.hpp): each is taken
 // with its value, bad values name the flag and the rule, and the domain comes from --domain,
 // else BBW_DOMAIN, else 0.
 #include <gtest/gtest.h>
@@ -6,13 +6,13 @@
 #include <string>
 #include <vector>
 
-#include "bbw/dds/process_cli.hpp"
+#include "bbw/runtime/process_cli.hpp"
 
 namespace {
 
-using bbw::dds::ArgCursor;
-using bbw::dds::ClockMode;
-using bbw::dds::ProcessFlags;
+using bbw::runtime::ArgCursor;
+using bbw::runtime::ClockMode;
+using bbw::runtime::ProcessFlags;
 
 // Parses argv (program name first) with the shared flags; returns the flags the parser did not
 // know, in order.
@@ -90,7 +90,7 @@ TEST(ProcessCli, BadInputNamesTheFlagAndTheRule) {
 }
 
 TEST(ProcessCli, UsageListsTheSharedFlagsThenTheProgramsOwn) {
-  const std::string u = bbw::dds::process_usage("bbw_corner", "--corner FL|FR|RL|RR", {"[--stats FILE]"});
+  const std::string u = bbw::runtime::process_usage("bbw_corner", "--corner FL|FR|RL|RR", {"[--stats FILE]"});
   EXPECT_EQ(u.rfind("usage: bbw_corner --corner FL|FR|RL|RR --scenario FILE", 0), 0u) << u;
   for (const char* flag : {"--domain", "--mode", "--discovery-timeout", "--peer-timeout", "--process-faults",
                            "--dds-profiles", "--dds-participant-profile", "--secure", "--stats"}) {

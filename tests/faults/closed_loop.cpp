@@ -140,9 +140,16 @@ LoopResult run_closed_loop(const FaultScenario& fs, const LoopOptions& options) 
     out.calibrator_restarts[s] = sup.calibrator_restarts();
     out.fits[s] = sup.calibrator().stats().fits_accepted;
     for (std::size_t p = 0; p < 5; ++p) out.diagnoses[s * 5 + p] = sup.monitor().diagnosis(static_cast<Part>(p));
-    for (const FaultSpec& f : fs.faults.faults) {
-      if (corner_slot(f.target) == s) out.outcomes.push_back(assess(f, sup.monitor()));
-    }
+  }
+  // Scored by the one fault scorer (bbw/faults/outcome.hpp) from the CCU node's detection log,
+  // as bbw_launch scores a DDS run from ccu.stats.
+  std::vector<DetectionEvent> events;
+  for (const node::DetectionRecord& d : run.ccu().detections()) {
+    events.push_back({static_cast<Target>(d.slot), d.finding, d.onset_s, d.detected_s});
+  }
+  for (const FaultSpec& f : fs.faults.faults) {
+    const auto slot = corner_slot(f.target);
+    if (slot && present[*slot]) out.outcomes.push_back(score_fault(f, events));
   }
   // Share of the demanded total delivered while each fault lasted.
   for (FaultOutcome& o : out.outcomes) {

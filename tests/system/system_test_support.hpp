@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "bbw/launch/child.hpp"
+#include "bbw/runtime/child.hpp"
 
 namespace bbw::system_test {
 
@@ -37,7 +37,7 @@ inline std::string scratch(const std::string& prefix, const std::string& test) {
 }
 
 struct ProcessRun {
-  bbw::launch::ExitStatus status;
+  bbw::runtime::ExitStatus status;
   std::string out, err, dir;
 };
 
@@ -47,7 +47,7 @@ inline ProcessRun run(const std::string& name, const std::vector<std::string>& a
                       std::chrono::seconds limit, const std::vector<std::string>& env = {}) {
   using namespace std::chrono_literals;
   std::filesystem::create_directories(dir);
-  bbw::launch::Child child(name, argv, dir + "/" + name + ".stdout", dir + "/" + name + ".stderr", env);
+  bbw::runtime::Child child(name, argv, dir + "/" + name + ".stdout", dir + "/" + name + ".stderr", env);
   auto status = child.wait_until(std::chrono::steady_clock::now() + limit);
   if (!status) status = child.stop(2000ms);
   return {*status, slurp(dir + "/" + name + ".stdout"), slurp(dir + "/" + name + ".stderr"), dir};
@@ -61,7 +61,7 @@ class Launch {
          const std::vector<std::string>& env = {})
       : dir_(dir), name_(name) {
     std::filesystem::create_directories(dir);
-    child_ = std::make_unique<bbw::launch::Child>(name, argv, stdout_file(), dir + "/" + name + ".stderr", env);
+    child_ = std::make_unique<bbw::runtime::Child>(name, argv, stdout_file(), dir + "/" + name + ".stderr", env);
   }
   std::string stdout_file() const { return dir_ + "/" + name_ + ".stdout"; }
   std::string err() const { return slurp(dir_ + "/" + name_ + ".stderr"); }
@@ -84,7 +84,7 @@ class Launch {
   }
   // The launcher's run id once printed ("bbw_launch: ..., run id <16 hex>, ..."; "" if never).
   std::string run_id(std::chrono::seconds limit = std::chrono::seconds(30)) { return wait_for_output(std::regex("run id ([0-9a-f]{16})"), limit); }
-  bbw::launch::ExitStatus wait(std::chrono::seconds limit) {
+  bbw::runtime::ExitStatus wait(std::chrono::seconds limit) {
     auto st = child_->wait_until(std::chrono::steady_clock::now() + limit);
     if (!st) st = child_->stop(std::chrono::milliseconds(3000));
     return *st;
@@ -97,7 +97,7 @@ class Launch {
 
  private:
   std::string dir_, name_;
-  std::unique_ptr<bbw::launch::Child> child_;
+  std::unique_ptr<bbw::runtime::Child> child_;
 };
 
 // The Fast DDS 2.9 discovery abort (docs/faults.md, "Realtime restart"): a process that joins a

@@ -13,7 +13,7 @@
 #include "bbw/dds/reader.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/dds/writer.hpp"
-#include "bbw/launch/child.hpp"
+#include "bbw/runtime/child.hpp"
 
 namespace {
 
@@ -25,7 +25,7 @@ TEST(DdsTwoProcess, EchoAnswersEveryBlockOfTheAddressedCorner) {
   std::filesystem::create_directories(logs);
   constexpr int kBlocks = 300;
   // The echo answers every corner; we send 2 corners' blocks and expect only RR's replies.
-  bbw::launch::Child echo("bbw_dds_echo",
+  bbw::runtime::Child echo("bbw_dds_echo",
                           {bin + "/bbw_dds_echo", "--domain", "144", "--mode", "lockstep",
                            "--max-blocks", std::to_string(2 * kBlocks)},
                           (logs / "echo.out").string(), (logs / "echo.err").string());

@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "bbw/common/csv.hpp"
-#include "bbw/launch/child.hpp"
+#include "bbw/runtime/child.hpp"
 #include "system_test_support.hpp"
-#include "bbw/launch/stats_file.hpp"
+#include "bbw/runtime/stats_file.hpp"
 
 namespace {
 
@@ -114,12 +114,12 @@ std::size_t expect_one_clean_restart(const std::string& out, const std::string& 
     EXPECT_EQ(num(c, "samples_rejected_by_guard"), 0.0) << c.at("corner");
   }
   const std::string ccu = out + "/ccu.stats";
-  const auto st = bbw::launch::read_stats(ccu);
-  EXPECT_EQ(bbw::launch::stat_number(st, corner + ".rejoins", ccu), 1.0);
+  const auto st = bbw::runtime::read_stats(ccu);
+  EXPECT_EQ(bbw::runtime::stat_number(st, corner + ".rejoins", ccu), 1.0);
   if (exact_calibrator_restarts) {
-    EXPECT_EQ(bbw::launch::stat_number(st, corner + ".calibrator_restarts", ccu), 1.0);
+    EXPECT_EQ(bbw::runtime::stat_number(st, corner + ".calibrator_restarts", ccu), 1.0);
   } else {
-    EXPECT_GE(bbw::launch::stat_number(st, corner + ".calibrator_restarts", ccu), 1.0);
+    EXPECT_GE(bbw::runtime::stat_number(st, corner + ".calibrator_restarts", ccu), 1.0);
   }
   bbw::csv::ReadOptions o;
   o.required = {"time_s", "seq"};

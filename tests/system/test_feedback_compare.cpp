@@ -10,7 +10,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "bbw/launch/child.hpp"
+#include "bbw/runtime/child.hpp"
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
@@ -19,7 +19,7 @@ TEST(FeedbackCompare, CompensatedFeedbackLowersTheVehicleStopsTrackingError) {
   const fs::path dir = fs::temp_directory_path() / ("bbw_system_feedback_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  bbw::launch::Child child("bbw_compare_feedback",
+  bbw::runtime::Child child("bbw_compare_feedback",
                            {std::string(BBW_TEST_BINARY_DIR) + "/bin/bbw_compare_feedback",
                             std::string(BBW_TEST_SOURCE_DIR) + "/config/scenarios/vehicle_stop.yaml", "--out",
                             (dir / "out").string(), "--domain", "195"},

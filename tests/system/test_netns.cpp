@@ -11,7 +11,7 @@
 //
 // Needs root (ip netns add); otherwise GTEST_SKIP with the reason. Domain 228. Every namespace
 // (and with it every veth and the bridge) is deleted by an RAII guard, also on failure; the
-// processes are killed before that (bbw::launch::Child's destructor).
+// processes are killed before that (bbw::runtime::Child's destructor).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
@@ -28,15 +28,15 @@
 #include <string>
 #include <vector>
 
-#include "bbw/launch/child.hpp"
-#include "bbw/launch/stats_file.hpp"
+#include "bbw/runtime/child.hpp"
+#include "bbw/runtime/stats_file.hpp"
 
 namespace {
 
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
-using bbw::launch::Child;
-using bbw::launch::Clock;
+using bbw::runtime::Child;
+using bbw::runtime::Clock;
 
 constexpr int kDomain = 228;
 const std::vector<std::string> kCorners = {"FL", "FR", "RL", "RR"};
@@ -337,8 +337,8 @@ TEST(SystemNetns, CornerLinkDownIsDetectedAndTheCornerRejoins) {
   // The CCU's own account: a link_lost detection for FL whose onset (FL's last block) lies in
   // the outage. Other corners may see a deadline miss when this shared 2-core machine stalls a
   // process for 15 ms; they are listed, and must be available at the end of the run.
-  const auto stats = bbw::launch::read_stats(out + "/ccu.stats");
-  const int n = static_cast<int>(bbw::launch::stat_number(stats, "detections", out + "/ccu.stats"));
+  const auto stats = bbw::runtime::read_stats(out + "/ccu.stats");
+  const int n = static_cast<int>(bbw::runtime::stat_number(stats, "detections", out + "/ccu.stats"));
   double onset = -1.0, detected = -1.0;
   std::string others;
   for (int i = 0; i < n; ++i) {
@@ -356,7 +356,7 @@ TEST(SystemNetns, CornerLinkDownIsDetectedAndTheCornerRejoins) {
   }
   ASSERT_GE(detected, 0.0) << "no link_lost detection for FL during its outage in ccu.stats\n" << slurp(out + "/ccu.stats");
   EXPECT_GT(onset, sim_before_down - 0.05) << "FL's outage began before its link went down";
-  EXPECT_GT(bbw::launch::stat_number(stats, "FL.deadlines_missed", out + "/ccu.stats"), 0.0);
+  EXPECT_GT(bbw::runtime::stat_number(stats, "FL.deadlines_missed", out + "/ccu.stats"), 0.0);
   {
     // The CCU's last period: every corner available again.
     std::ifstream f(periods);
@@ -367,8 +367,8 @@ TEST(SystemNetns, CornerLinkDownIsDetectedAndTheCornerRejoins) {
     EXPECT_EQ(last.substr(last.size() - 8), ",1,1,1,1") << "not every corner available at the end:\n" << header << "\n" << last;
   }
   // The corner saw the CCU's commands stop too.
-  const auto fl = bbw::launch::read_stats(out + "/corner_FL.stats");
-  EXPECT_GT(bbw::launch::stat_number(fl, "command_deadlines_missed", out + "/corner_FL.stats"), 0.0);
+  const auto fl = bbw::runtime::read_stats(out + "/corner_FL.stats");
+  EXPECT_GT(bbw::runtime::stat_number(fl, "command_deadlines_missed", out + "/corner_FL.stats"), 0.0);
 
   // FL's samples arrive after the outage: the CCU's log holds samples later than the moment FL
   // became available again, up to the end of the run.

@@ -3,7 +3,9 @@
 // Domains 200-211, one per test (noted per test); runs that share a domain do so on purpose.
 // Every process is bounded (launcher wall-time bound, waits with deadlines); nothing sleeps.
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -20,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "bbw/launch/child.hpp"
+#include "bbw/runtime/child.hpp"
 #include "system_test_support.hpp"
 
 namespace {
@@ -43,7 +45,7 @@ std::vector<std::string> launch_argv(const std::string& scenario, const std::str
   return a;
 }
 
-std::string describe(const bbw::launch::ExitStatus& st, Launch& l) { return st.describe() + "\n" + l.out() + l.err(); }
+std::string describe(const bbw::runtime::ExitStatus& st, Launch& l) { return st.describe() + "\n" + l.out() + l.err(); }
 
 // Children of `pid` (from /proc), by their command name (comm).
 std::map<std::string, pid_t> children_of(pid_t pid) {
@@ -264,6 +266,72 @@ void stop_midway(int sig, int domain, const std::string& name) {
 
 TEST(SystemStops, SigtermKeepsAPartialSummaryAndExits143) { stop_midway(SIGTERM, 204, "sigterm"); }
 TEST(SystemStops, SigintKeepsAPartialSummaryAndExits130) { stop_midway(SIGINT, 205, "sigint"); }
+
+// Domain 211 (never joined): a stop while the DDS Security keys are created, before any run
+// process starts, still writes a partial summary marked interrupted and exits 128 + signal.
+// The key script is replaced (BBW_LAUNCH_KEYS_SCRIPT) by one that says it started and waits.
+void stop_before_start(int sig, const std::string& name) {
+  const std::string dir = scratch(name);
+  const std::string marker = dir + "/keys_started";
+  const std::string script = dir + "/slow-keys.sh";
+  {
+    std::ofstream f(script);
+    f << "#!/bin/sh\ntouch '" << marker << "'\nexec sleep 120\n";
+  }
+  fs::permissions(script, fs::perms::owner_all);
+  Launch l(dir, "bbw_launch",
+           launch_argv("tests/system/data/long_stop.yaml", dir + "/out", "lockstep", 211,
+                       {"--secure", "--keys", dir + "/keys"}),
+           {"BBW_LAUNCH_KEYS_SCRIPT=" + script});
+  const auto end = Clock::now() + 30s;
+  while (!fs::exists(marker) && Clock::now() < end && !l.ended_within(20ms)) {
+  }
+  ASSERT_TRUE(fs::exists(marker)) << "the key script never started\n" << l.out() << l.err();
+  l.signal(sig);
+  const auto st = l.wait(30s);
+  EXPECT_TRUE(st.exited && st.code == 128 + sig) << describe(st, l);
+  const std::string j = slurp(dir + "/out/summary.json");
+  ASSERT_FALSE(j.empty()) << "no summary after a stop before the start\n" << l.err();
+  EXPECT_EQ(field(j, "interrupted"), "true") << j;
+  EXPECT_EQ(field(j, "complete"), "false") << j;
+  EXPECT_EQ(field(j, "signal"), sig == SIGINT ? "SIGINT" : "SIGTERM") << j;
+  EXPECT_NE(field(j, "failure").find("before the run's processes started"), std::string::npos) << j;
+  EXPECT_TRUE(objects(j, "processes").empty()) << j;
+  EXPECT_EQ(objects(j, "corners").size(), 4u) << j;
+  EXPECT_FALSE(fs::exists(dir + "/out/ccu.out")) << "a run process was started after the stop";
+  fs::remove_all(dir);
+}
+
+TEST(SystemStops, SigtermWhileKeysAreCreatedKeepsAPartialSummaryAndExits143) { stop_before_start(SIGTERM, "keys_sigterm"); }
+
+// Domain 211 (never joined): a launcher waiting for another launcher's lock on the keys folder
+// (here held by the test) is stopped the same way.
+TEST(SystemStops, SigtermWhileWaitingForTheKeysLockKeepsAPartialSummaryAndExits143) {
+  const std::string dir = scratch("keys_lock");
+  const std::string keys = dir + "/keys";
+  const std::string lock = "/tmp/bbw-keys-" + std::to_string(std::hash<std::string>{}(keys)) + ".lock";
+  const int fd = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  ASSERT_GE(fd, 0) << lock;
+  ASSERT_EQ(::flock(fd, LOCK_EX), 0) << lock;
+  Launch l(dir, "bbw_launch",
+           launch_argv("tests/system/data/long_stop.yaml", dir + "/out", "lockstep", 211, {"--secure", "--keys", keys}));
+  // The output folder is prepared before the keys are looked at: wait for it (bounded).
+  const auto end = Clock::now() + 30s;
+  while (!fs::exists(dir + "/out") && Clock::now() < end && !l.ended_within(20ms)) {
+  }
+  ASSERT_FALSE(l.ended_within(200ms)) << "the launcher did not wait for the lock\n" << l.out() << l.err();
+  l.signal(SIGTERM);
+  const auto st = l.wait(30s);
+  ::close(fd);
+  EXPECT_TRUE(st.exited && st.code == 128 + SIGTERM) << describe(st, l);
+  const std::string j = slurp(dir + "/out/summary.json");
+  ASSERT_FALSE(j.empty()) << "no summary after a stop while waiting for the keys lock\n" << l.err();
+  EXPECT_EQ(field(j, "interrupted"), "true") << j;
+  EXPECT_NE(field(j, "failure").find("before the run's processes started"), std::string::npos) << j;
+  EXPECT_FALSE(fs::exists(dir + "/out/keys.out")) << "the key script ran without the lock";
+  fs::remove_all(dir);
+}
+TEST(SystemStops, SigintWhileKeysAreCreatedKeepsAPartialSummaryAndExits130) { stop_before_start(SIGINT, "keys_sigint"); }
 
 // Domain 206 (the killed run) and 207 (the next launch): a SIGKILLed CCU still yields a summary
 // from what the corners logged, naming the lost process; the port files and semaphores its

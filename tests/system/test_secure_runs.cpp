@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "bbw/launch/child.hpp"
+#include "bbw/runtime/child.hpp"
 #include "system_test_support.hpp"
-#include "bbw/launch/stats_file.hpp"
+#include "bbw/runtime/stats_file.hpp"
 
 namespace {
 
@@ -79,12 +79,12 @@ ProcessRun launch(const std::string& dir, int domain, const std::string& mode, b
 
 // Waits (bounded) for a launcher started by start_launch(), as launch() would have run it.
 [[maybe_unused]] ProcessRun finish_launch(Launch& l) {
-  const bbw::launch::ExitStatus st = l.wait(150s);
+  const bbw::runtime::ExitStatus st = l.wait(150s);
   return {st, l.out(), l.err(), ""};
 }
 
 double stat(const std::string& file, const std::string& key) {
-  return bbw::launch::stat_number(bbw::launch::read_stats(file), key, file);
+  return bbw::runtime::stat_number(bbw::runtime::read_stats(file), key, file);
 }
 
 // A CSV file as rows of numbers by column name ("nan", "inf" parse as such).
@@ -128,11 +128,11 @@ class Intruder {
       : dir_(dir), name_(name) {
     args.insert(args.begin(), bin("bbw_intruder"));
     if (niced) args.insert(args.begin(), {"/usr/bin/nice", "-n", "19"});
-    child_ = std::make_unique<bbw::launch::Child>(name, args, dir + "/" + name + ".stdout", dir + "/" + name + ".stderr");
+    child_ = std::make_unique<bbw::runtime::Child>(name, args, dir + "/" + name + ".stdout", dir + "/" + name + ".stderr");
   }
   bool running() { return !child_->poll().has_value(); }
   // Stops it (SIGTERM ends its attempt) and waits (bounded) for the end; its exit status.
-  bbw::launch::ExitStatus stop(std::chrono::seconds limit) {
+  bbw::runtime::ExitStatus stop(std::chrono::seconds limit) {
     if (running()) child_->send_signal(SIGTERM);
     auto st = child_->wait_until(Clock::now() + limit);
     if (!st) st = child_->stop(2000ms);
@@ -140,14 +140,14 @@ class Intruder {
   }
   // stop(), expecting a clean end; the JSON line it printed.
   std::string finish(std::chrono::seconds limit) {
-    const bbw::launch::ExitStatus st = stop(limit);
+    const bbw::runtime::ExitStatus st = stop(limit);
     EXPECT_TRUE(st.ok()) << name_ << ": " << st.describe() << "\n" << slurp(dir_ + "/" + name_ + ".stderr");
     return slurp(dir_ + "/" + name_ + ".stdout");
   }
 
  private:
   std::string dir_, name_;
-  std::unique_ptr<bbw::launch::Child> child_;
+  std::unique_ptr<bbw::runtime::Child> child_;
 };
 
 // "key":number from the intruder's JSON line (-1 when absent).
@@ -361,7 +361,7 @@ TEST(SystemHostileInput, AFloodingCornerDoesNotDelayTheOthersCommands) {
                    true);
     const ProcessRun r = finish_launch(*l);
     const bool flood_lasted = flood.running();
-    const bbw::launch::ExitStatus flood_status = flood.stop(20s);
+    const bbw::runtime::ExitStatus flood_status = flood.stop(20s);
     const std::string out = dir + "/out", ccu = out + "/ccu.stats";
     const std::string aborted = !flood_lasted && slurp(dir + "/intruder_flood.stderr").find("PDP.cpp") != std::string::npos
                                     ? dir + "/intruder_flood.stderr"

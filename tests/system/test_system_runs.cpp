@@ -17,8 +17,9 @@
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/calibration/offline.hpp"
 #include "bbw/common/csv.hpp"
-#include "bbw/launch/child.hpp"
-#include "bbw/launch/stats_file.hpp"
+#include "bbw/runtime/child.hpp"
+#include "bbw/runtime/run_stats.hpp"
+#include "bbw/runtime/stats_file.hpp"
 #include "system_test_support.hpp"
 
 namespace {
@@ -40,7 +41,7 @@ ProcessRun launch(const std::string& scenario, const std::string& dir, int domai
 }
 
 double stat(const std::string& file, const std::string& key) {
-  return bbw::launch::stat_number(bbw::launch::read_stats(file), key, file);
+  return bbw::runtime::stat_number(bbw::runtime::read_stats(file), key, file);
 }
 
 // Domain 160.
@@ -64,9 +65,22 @@ TEST(SystemLockstep, FiveProcessesCompleteWithoutGapsOrLostSamples) {
     EXPECT_EQ(stat(cs, "commands_applied"), 800.0) << c;
     EXPECT_GT(stat(ccu, p + "fits_accepted"), 0.0) << c << ": the calibrator never fitted";
   }
+  // The same files through the typed structs the launcher reads them with (every key known).
+  const auto typed = bbw::runtime::load_ccu_stats(ccu);
+  EXPECT_EQ(typed.periods_done, 800u);
+  EXPECT_EQ(typed.corners.size(), 4u);
+  EXPECT_EQ(bbw::runtime::load_corner_stats(out + "/corner_RR.stats").samples_published, 4000u);
   const std::string summary = slurp(out + "/summary.json");
   EXPECT_NE(summary.find("\"samples_lost\": 0"), std::string::npos) << summary;
   EXPECT_NE(summary.find("\"sequence_gaps\": 0"), std::string::npos) << summary;
+  // A rig run has no clamp-force command: its tracking errors are null with the reason, never
+  // 0; its estimate was scored (the reason is null).
+  EXPECT_EQ(summary.find("\"tracking_rms_error_kN\": 0"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"tracking_rms_error_kN\": null"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"tracking_not_scored_reason\": \"no sample was under a clamp-force command\""),
+            std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"not_scored_reason\": null"), std::string::npos) << summary;
+  EXPECT_EQ(summary.find("\"estimate_max_abs_error_kN\": null"), std::string::npos) << summary;
   fs::remove_all(dir);
 }
 

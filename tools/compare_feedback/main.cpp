@@ -13,11 +13,13 @@
 #include <string>
 #include <vector>
 
-#include <yaml-cpp/yaml.h>
-
 #include "bbw/common/json.hpp"
+#include "summary_reader.hpp"
 
 namespace {
+
+using bbw::compare_feedback::read_summary;
+using bbw::compare_feedback::Tracking;
 
 const char* kUsage = "usage: bbw_compare_feedback SCENARIO.yaml --out DIR [--mode lockstep|realtime] [--domain N]\n";
 
@@ -36,26 +38,6 @@ int run_launch(const std::vector<std::string>& args) {
   while (waitpid(pid, &status, 0) < 0) {
   }
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
-struct Tracking {
-  double rms = 0, max = 0, steady_rms = 0, steady_max = 0;
-  long long fits = 0;
-};
-
-std::map<std::string, Tracking> read_summary(const std::string& file) {
-  const YAML::Node root = YAML::LoadFile(file);  // JSON is YAML
-  std::map<std::string, Tracking> out;
-  for (const auto& c : root["corners"]) {
-    Tracking t;
-    t.rms = c["tracking_rms_error_kN"].as<double>();
-    t.max = c["tracking_max_abs_error_kN"].as<double>();
-    t.steady_rms = c["tracking_steady_rms_error_kN"].as<double>();
-    t.steady_max = c["tracking_steady_max_abs_error_kN"].as<double>();
-    t.fits = c["fits_accepted"].as<long long>();
-    out[c["corner"].as<std::string>()] = t;
-  }
-  return out;
 }
 
 }  // namespace

@@ -8,21 +8,15 @@
 #include <string>
 #include <vector>
 
+#include "bbw/faults/outcome.hpp"
 #include "bbw/faults/schedule.hpp"
+#include "bbw/runtime/run_stats.hpp"
 #include "bbw/scenario/scenario.hpp"
 
 namespace bbw::launch {
 
-struct Detection {
-  std::string corner;   // FL, FR, RL, RR
-  std::string finding;  // faults::to_string(Finding)
-  std::string part;     // faults::to_string(Part)
-  double onset_s = 0.0;
-  double detected_s = 0.0;
-};
-
-// The detection.N.* keys of ccu.stats (none when the file has no such keys).
-std::vector<Detection> read_detections(const std::map<std::string, std::string>& ccu_stats, const std::string& file);
+// A detection of the CCU's fault monitor as ccu.stats holds it (bbw/runtime/run_stats.hpp).
+using Detection = runtime::DetectionStats;
 
 struct TimelinePoint {
   double time_s = 0.0;          // end of the period
@@ -35,20 +29,11 @@ struct TimelinePoint {
 std::vector<TimelinePoint> build_timeline(const scenario::Scenario& s,
                                           const std::vector<std::vector<std::pair<double, double>>>& period_logs);
 
-struct FaultResult {
-  faults::FaultSpec fault;
-  bool detected = false;
-  double detected_s = 0.0;        // first detection of anything on the faulty corner (CCU: first watchdog)
-  double latency_ms = 0.0;        // detected_s - injection
-  double diagnosis_s = 0.0;       // when the diagnosis below was made (the right part's, if any)
-  double diagnosis_latency_ms = 0.0;
-  std::string diagnosis = "none";
-  bool correct = false;
-  std::string reaction = "none";
-  double delivered_share = 1.0;  // delivered / demanded total while the fault lasted
-};
+// Scored by the one fault scorer (bbw/faults/outcome.hpp), shared with the closed-loop tests.
+using FaultResult = faults::FaultOutcome;
 
 // ccu_lost_s: per corner, the simulated time its watchdog found the CCU lost (< 0: never).
+// Throws std::runtime_error on a detection whose corner or finding bbw does not know.
 std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, const std::vector<Detection>& detections,
                                        const std::map<std::string, double>& ccu_lost_s,
                                        const std::vector<TimelinePoint>& timeline, double run_end_s);

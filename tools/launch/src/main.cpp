@@ -30,122 +30,78 @@
 // realtime: restart_after_s of wall time later). A scheduled kill is not a failure: after a CCU
 // kill the corners run to the end in their safe state and the run is reported as ended by the
 // injected fault. Any other death is an error naming the process.
-#include <fcntl.h>
 #include <signal.h>
-#include <sys/file.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
-#include <cmath>
-#include <cstdlib>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <memory>
-#include <map>
 #include <optional>
-#include <set>
-#include <sstream>
 #include <string>
-#include <vector>
 
-#include "bbw/common/json.hpp"
-#include "bbw/dds/domain.hpp"
-#include "bbw/dds/process_cli.hpp"
+#include "bbw/common/data_path.hpp"
 #include "bbw/dds/run_id.hpp"
 #include "bbw/dds/shm_cleanup.hpp"
-#include "bbw/faults/link_faults.hpp"
-#include "bbw/faults/schedule_yaml.hpp"
-#include "bbw/common/data_path.hpp"
-#include "bbw/launch/child.hpp"
-#include "bbw/launch/signals.hpp"
-#include "bbw/launch/stats_file.hpp"
-#include "bbw/scenario/load.hpp"
-#include "bbw/scenario/run_checks.hpp"
-#include "bbw/security/dds_security.hpp"
+#include "bbw/runtime/signals.hpp"
 #include "domain_claim.hpp"
-#include "fault_report.hpp"
+#include "options.hpp"
 #include "out_dir.hpp"
 #include "partial_summary.hpp"
-#include "report.hpp"
 #include "summary.hpp"
+#include "supervisor.hpp"
 
 namespace {
 
-using namespace std::chrono_literals;
-using bbw::launch::Child;
-using bbw::launch::Clock;
+std::string signal_name(int sig) { return sig == SIGINT ? "SIGINT" : "SIGTERM"; }
 
-const char* kUsage =
-    "usage: bbw_launch SCENARIO.yaml --out DIR [--mode lockstep|realtime] [--domain N]\n"
-    "                  [--discovery-timeout S] [--friction-feedback on|off] [--no-report]\n"
-    "                  [--secure [--keys DIR]] [--allow-large]\n";
-
-std::string last_line(const std::string& file) {
-  std::ifstream f(file);
-  std::string line, last;
-  while (std::getline(f, line)) {
-    if (!line.empty()) last = line;
+// The partial summary of a run that did not finish (bbw/launch partial_summary.hpp); returns
+// the launcher's exit code: 128 + the signal when stopped, else 1.
+int write_partial(const bbw::launch::RunPlan& plan, const std::string& failure, int sig,
+                  const std::vector<bbw::launch::ProcessEnd>& processes,
+                  const std::map<std::string, unsigned>& incarnations) {
+  std::cerr << "bbw_launch: " << failure << " (logs in " << plan.out_dir << ")\n";
+  bbw::launch::PartialRun run;
+  run.scenario = plan.scenario;
+  run.scenario_file = plan.scenario_file;
+  run.mode = plan.mode;
+  run.domain = plan.domain;
+  run.run_id = plan.run_id;
+  run.secure = plan.secure;
+  run.out_dir = plan.out_dir;
+  run.failure = failure;
+  run.interrupted = sig != 0;
+  run.signal = sig;
+  run.processes = processes;
+  run.incarnations = incarnations;
+  try {
+    const auto lost = bbw::launch::write_partial_summary(run);
+    for (const auto& name : lost) std::cerr << "bbw_launch: lost process: " << name << "\n";
+    std::cerr << "bbw_launch: partial summary in " << plan.out_dir << "/summary.json\n";
+  } catch (const std::exception& e) {
+    std::cerr << "bbw_launch: partial summary failed: " << e.what() << "\n";
   }
-  return last;
-}
-
-std::string reason(const bbw::launch::ExitStatus& s) {
-  if (!s.exited) return s.describe();
-  switch (s.code) {
-    case 1: return "exit 1 (runtime or DDS error)";
-    case 2: return "exit 2 (bad arguments or configuration)";
-    case 3: return "exit 3 (discovery did not complete in time)";
-    case 4: return "exit 4 (peer lost or failed)";
-    case 127: return "exit 127 (could not be executed)";
-    default: return s.describe();
-  }
+  return sig != 0 ? 128 + sig : 1;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::unique_ptr<Child>> children;
-  std::atomic<bool> interrupted{false};
+  // First, before any thread exists: SIGINT/SIGTERM go to the watcher only.
   std::atomic<int> stop_signal{0};
-  bbw::launch::SignalWatcher signals([&](int sig) {
-    stop_signal.store(sig);
-    interrupted.store(true);
-  });
+  bbw::runtime::SignalWatcher signals([&](int sig) { stop_signal.store(sig); });
 
-  std::string scenario_file, out_dir, mode = "lockstep", feedback = "on";
-  std::optional<std::string> domain_arg;
-  double discovery_s = 20.0;
-  bool report = true;
-  bool secure = false;
-  bool allow_large = false;  // --allow-large: accept a run over the size limits (scenario/run_checks.hpp)
-  std::string keys_dir;  // default: keys/ in bbw's data root (bbw/common/data_path.hpp)
-  int domain = 0;
+  bbw::launch::Options opt;
+  int domain = -1;
   try {
-    for (bbw::dds::ArgCursor args(argc, argv); !args.done();) {
-      const std::string k = args.flag();
-      auto next = [&] { return args.value(); };
-      if (k == "--out") out_dir = next();
-      else if (k == "--mode") bbw::dds::parse_clock_mode(mode = next());
-      else if (k == "--domain") domain_arg = next();
-      else if (k == "--discovery-timeout") {
-        discovery_s = static_cast<double>(bbw::dds::seconds_arg(k, next(), 600.0).count()) / 1000.0;
-      } else if (k == "--friction-feedback") feedback = next();
-      else if (k == "--no-report") report = false;
-      else if (k == "--secure") secure = true;
-      else if (k == "--keys") keys_dir = next();
-      else if (k == "--allow-large") allow_large = true;
-      else if (k == "-h" || k == "--help") { std::cout << kUsage; return 0; }
-      else if (!k.empty() && k[0] == '-') throw std::invalid_argument("unknown argument '" + k + "'");
-      else if (scenario_file.empty()) scenario_file = k;
-      else throw std::invalid_argument("unexpected argument '" + k + "'");
+    opt = bbw::launch::parse_options(argc, argv);
+    if (opt.help) {
+      std::cout << bbw::launch::kUsage;
+      return 0;
     }
-    if (scenario_file.empty()) throw std::invalid_argument("a scenario file is required");
-    if (out_dir.empty()) throw std::invalid_argument("--out DIR is required");
-    if (feedback != "on" && feedback != "off") throw std::invalid_argument("--friction-feedback must be on or off");
-    domain = bbw::dds::resolve_domain_id(domain_arg, std::getenv("BBW_DOMAIN"), -1);
+    domain = bbw::launch::requested_domain(opt);
   } catch (const std::exception& e) {
-    std::cerr << "bbw_launch: " << e.what() << "\n" << kUsage;
+    std::cerr << "bbw_launch: " << e.what() << "\n" << bbw::launch::kUsage;
     return 2;
   }
   // The run id (never the scenario seed): every child gets it, every endpoint lives in
@@ -162,513 +118,106 @@ int main(int argc, char** argv) {
     std::cerr << "bbw_launch: " << e.what() << "\n";
     return 1;
   }
-  const std::string run_hex = bbw::dds::run_id_hex(run_id);
-
-  // Validate the scenario before starting anything.
-  std::optional<bbw::scenario::Scenario> scenario;
-  bbw::faults::FaultSchedule schedule;
+  // Validate the scenario and prepare the output folder before starting anything.
+  std::optional<bbw::launch::LoadedRun> loaded;
   try {
-    auto fs = bbw::faults::load_fault_scenario(scenario_file);
-    scenario = std::move(fs.scenario);
-    schedule = std::move(fs.faults);
-    bbw::scenario::check_four_corner_run(*scenario);
-    if (!allow_large) bbw::scenario::check_run_size(*scenario);
-    for (const auto& a : bbw::faults::process_actions(schedule)) {
-      if (a.target == bbw::faults::Target::CCU && a.kind == bbw::faults::ProcessAction::Kind::Restart) {
-        throw std::invalid_argument(scenario_file + ": restarting the CCU is not supported over DDS (a kill of the CCU ends the run)");
-      }
-    }
-  } catch (const std::exception& e) {
-    std::cerr << "bbw_launch: " << e.what() << "\n";
-    return 2;
-  }
-  try {
-    const auto cleared = bbw::launch::prepare_out_dir(out_dir);
+    loaded = bbw::launch::load_run(opt);
+    const auto cleared = bbw::launch::prepare_out_dir(opt.out_dir);
     if (!cleared.removed.empty()) {
-      std::cout << "bbw_launch: removed " << cleared.removed.size() << " files of an older run from " << out_dir
+      std::cout << "bbw_launch: removed " << cleared.removed.size() << " files of an older run from " << opt.out_dir
                 << std::endl;
     }
   } catch (const std::exception& e) {
     std::cerr << "bbw_launch: " << e.what() << "\n";
     return 2;
   }
-  if (secure) {
-    // Keys: created by scripts/bbw-keys.sh when any file is missing (idempotent), then checked.
+  if (opt.secure) {
     std::error_code ec;
-    if (keys_dir.empty()) keys_dir = bbw::data::root() + "/keys";
-    keys_dir = std::filesystem::absolute(keys_dir, ec).lexically_normal().string();
-    // One launcher at a time checks and creates the keys of a directory (two runs started at
-    // once must not both write it): an flock on a lock file named after it, held until here ends.
-    const std::string keys_lock = "/tmp/bbw-keys-" + std::to_string(std::hash<std::string>{}(keys_dir)) + ".lock";
-    const int keys_lock_fd = ::open(keys_lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
-    if (keys_lock_fd < 0 || ::flock(keys_lock_fd, LOCK_EX) != 0) {
-      std::cerr << "bbw_launch: cannot lock " << keys_lock << " for the keys in " << keys_dir << "\n";
-      return 1;
-    }
-    struct CloseLock {
-      int fd;
-      ~CloseLock() { ::close(fd); }
-    } close_keys_lock{keys_lock_fd};
-    auto check_keys = [&]() -> std::string {
-      try {
-        for (const auto& id : bbw::security::identities()) bbw::security::files_for(keys_dir, id);
-      } catch (const std::exception& e) {
-        return e.what();
-      }
-      // Permissions written before runs had their own partitions (issue 17) grant no run_*
-      // partition: scripts/bbw-keys.sh re-signs them (it keeps every key that still verifies).
-      std::ifstream perm(keys_dir + "/fl/permissions.xml");
-      const std::string text((std::istreambuf_iterator<char>(perm)), std::istreambuf_iterator<char>());
-      if (text.find("run_*") == std::string::npos) return keys_dir + "/fl/permissions.xml grants no per-run partition";
-      return "";
-    };
-    if (!check_keys().empty()) {
-      std::cout << "bbw_launch: creating DDS Security keys in " << keys_dir << std::endl;
-      Child keys("bbw-keys.sh", {bbw::data::path("scripts/bbw-keys.sh"), keys_dir},
-                 out_dir + "/keys.out", out_dir + "/keys.err");
-      const auto st = keys.wait_until(Clock::now() + 120s);
-      if (!st || !st->ok()) {
-        if (!st) keys.stop(1000ms);
-        std::cerr << "bbw_launch: scripts/bbw-keys.sh " << keys_dir << " failed ("
-                  << (st ? st->describe() : std::string("no exit within 120 s")) << "): "
-                  << last_line(out_dir + "/keys.err") << "\n";
-        return 1;
-      }
-    }
-    if (const std::string missing = check_keys(); !missing.empty()) {
-      std::cerr << "bbw_launch: " << missing << "\n";
-      return 2;
+    if (opt.keys_dir.empty()) opt.keys_dir = bbw::data::root() + "/keys";
+    opt.keys_dir = std::filesystem::absolute(opt.keys_dir, ec).lexically_normal().string();
+  }
+  bbw::launch::RunPlan plan;
+  plan.scenario = &loaded->scenario;
+  plan.schedule = &loaded->schedule;
+  plan.scenario_file = opt.scenario_file;
+  plan.out_dir = opt.out_dir;
+  plan.mode = opt.mode;
+  plan.friction_feedback = opt.friction_feedback;
+  plan.run_id = bbw::dds::run_id_hex(run_id);
+  plan.keys_dir = opt.keys_dir;
+  plan.domain = domain;
+  plan.discovery_s = opt.discovery_s;
+  plan.secure = opt.secure;
+
+  // A SIGINT/SIGTERM before the run's processes start (while the keys are created, say) still
+  // leaves a partial summary marked interrupted, and the exit is 128 + the signal.
+  auto stopped_before_start = [&]() -> std::optional<int> {
+    const int sig = stop_signal.load();
+    if (sig == 0) return std::nullopt;
+    return write_partial(plan, "interrupted by " + signal_name(sig) + " before the run's processes started", sig, {}, {});
+  };
+  if (const auto rc = stopped_before_start()) return *rc;
+  if (opt.secure) {
+    std::string error;
+    bool bad_keys = false;
+    const auto keys = bbw::launch::ensure_keys(opt.keys_dir, opt.out_dir, stop_signal, error, bad_keys);
+    if (keys == bbw::launch::KeysResult::Interrupted) return *stopped_before_start();
+    if (keys == bbw::launch::KeysResult::Failed) {
+      std::cerr << "bbw_launch: " << error << "\n";
+      return bad_keys ? 2 : 1;
     }
   }
   const auto shm = bbw::dds::cleanup_stale_shm();
   if (!shm.removed.empty()) {
     std::cout << "bbw_launch: removed " << shm.removed.size() << " stale Fast DDS shared-memory files" << std::endl;
   }
+  if (const auto rc = stopped_before_start()) return *rc;
 
-  const std::string bin = bbw::launch::executable_dir();
-  // Test hook: BBW_LAUNCH_CORNER_BIN replaces the corner executable (e.g. one that fails to
-  // start), so the failure path is exercised with real processes.
-  const char* corner_bin_env = std::getenv("BBW_LAUNCH_CORNER_BIN");
-  const std::string corner_bin = corner_bin_env && *corner_bin_env ? corner_bin_env : bin + "/bbw_corner";
-  const std::string dom = std::to_string(domain);
-  const std::string disc = std::to_string(discovery_s);
-  const auto wall0 = Clock::now();
-  const auto actions = bbw::faults::process_actions(schedule);
-  const bool process_faults = !actions.empty();
-  // A corner restart runs every process on UDP over 127.0.0.1 without shared memory (profile
-  // bbw_localhost_udp in config/dds/bbw_profiles.xml explains why).
-  bool corner_restarts = false;
-  for (const auto& a : actions) corner_restarts |= a.kind == bbw::faults::ProcessAction::Kind::Restart;
-  const std::vector<std::string> profile_args =
-      corner_restarts ? std::vector<std::string>{"--dds-participant-profile", "bbw_localhost_udp"}
-                      : std::vector<std::string>{};
-  // Where each corner's incarnations keep their stats and per-period log.
-  auto corner_stats_file = [&](const std::string& c, unsigned n) {
-    return out_dir + "/corner_" + c + (n == 0 ? "" : "." + std::to_string(n)) + ".stats";
-  };
-  std::map<std::string, unsigned> incarnations;  // corner -> processes started
-  auto spawn_corner = [&](const std::string& c, unsigned incarnation, double resume_at_s) {
-    std::vector<std::string> args{corner_bin, "--corner", c, "--scenario", scenario_file, "--domain", dom,
-                                  "--run-id", run_hex, "--mode", mode, "--stats", corner_stats_file(c, incarnation),
-                                  "--periods-log", out_dir + "/corner_" + c + "_periods.csv",
-                                  "--discovery-timeout", disc};
-    if (process_faults) {
-      args.push_back("--process-faults");
-      // In lockstep the CCU may hold the clock for a restarted corner for up to the discovery
-      // timeout: the other corners must wait for their next command at least that long.
-      args.insert(args.end(), {"--peer-timeout", std::to_string(discovery_s + 10.0)});
-    }
-    if (secure) args.insert(args.end(), {"--secure", keys_dir});
-    args.insert(args.end(), profile_args.begin(), profile_args.end());
-    if (incarnation > 0) {
-      args.insert(args.end(), {"--incarnation", std::to_string(incarnation), "--resume-at", std::to_string(resume_at_s)});
-    }
-    const std::string suffix = incarnation == 0 ? "" : "." + std::to_string(incarnation);
-    children.push_back(std::make_unique<Child>("bbw_corner " + c + suffix, args,
-                                               out_dir + "/corner_" + c + suffix + ".out",
-                                               out_dir + "/corner_" + c + suffix + ".err"));
-    incarnations[c] = incarnation + 1;
-  };
+  const auto wall0 = std::chrono::steady_clock::now();
+  bbw::launch::Supervisor supervisor(plan, stop_signal);
   try {
-    std::vector<std::string> ccu_argv{bin + "/bbw_ccu", "--scenario", scenario_file, "--domain", dom, "--run-id", run_hex, "--mode", mode,
-                                      "--out", out_dir, "--discovery-timeout", disc, "--friction-feedback", feedback};
-    if (process_faults) ccu_argv.push_back("--process-faults");
-    if (secure) ccu_argv.insert(ccu_argv.end(), {"--secure", keys_dir});
-    ccu_argv.insert(ccu_argv.end(), profile_args.begin(), profile_args.end());
-    children.push_back(std::make_unique<Child>("bbw_ccu", ccu_argv, out_dir + "/ccu.out", out_dir + "/ccu.err"));
-    for (const auto& c : scenario->corners) spawn_corner(c.name, 0, 0.0);
+    supervisor.start();
   } catch (const std::exception& e) {
     std::cerr << "bbw_launch: " << e.what() << "\n";
-    for (auto& c : children) c->stop(2000ms);
     return 1;
   }
-  std::cout << "bbw_launch: " << scenario->name << ", " << mode << ", domain " << domain
-            << (domain_claim.domain() >= 0 ? " (chosen free)" : "") << ", run id " << run_hex << ", "
-            << children.size() << " processes, discovery deadline " << discovery_s << " s"
-            << (process_faults ? ", process faults scheduled" : "") << std::endl;
-
-  // Bound on the whole run: discovery plus a generous multiple of the simulated duration (and
-  // one more discovery per scheduled restart).
-  std::size_t restarts_planned = 0;
-  for (const auto& a : actions) restarts_planned += a.kind == bbw::faults::ProcessAction::Kind::Restart ? 1 : 0;
-  const double bound_s = discovery_s * static_cast<double>(1 + restarts_planned) +
-                         (mode == "lockstep" ? 10.0 * scenario->duration_s + 60.0 : 1.5 * scenario->duration_s + 20.0);
-  const auto deadline = wall0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(bound_s));
-  // Scheduled kills not yet carried out, per process name; restarts waiting for their time.
-  std::map<std::string, std::vector<const bbw::faults::ProcessAction*>> kills_due;
-  for (const auto& a : actions) {
-    if (a.kind == bbw::faults::ProcessAction::Kind::Kill) {
-      kills_due[a.target == bbw::faults::Target::CCU ? std::string("bbw_ccu") : std::string(bbw::faults::to_string(a.target))]
-          .push_back(&a);
-    }
+  std::cout << "bbw_launch: " << plan.scenario->name << ", " << plan.mode << ", domain " << domain
+            << (domain_claim.domain() >= 0 ? " (chosen free)" : "") << ", run id " << plan.run_id << ", "
+            << supervisor.processes() << " processes, discovery deadline " << plan.discovery_s << " s"
+            << (supervisor.process_faults() ? ", process faults scheduled" : "") << std::endl;
+  const bbw::launch::SupervisedRun result = supervisor.run();
+  if (!result.failure.empty()) {
+    // A partial summary from whatever each process logged.
+    return write_partial(plan, result.failure, stop_signal.load(), result.processes, result.incarnations);
   }
-  struct PendingRestart {
-    std::string corner;
-    double resume_at_s;
-    Clock::time_point when;
-  };
-  std::vector<PendingRestart> restarts;
-  std::set<const Child*> killed_by_schedule, handled;
-  bool ccu_killed = false;
-  double ccu_killed_at_s = -1.0;
-  std::string failure;
-  auto corner_of = [](const std::string& name) { return name.substr(11, 2); };  // "bbw_corner XX[.n]"
-  for (;;) {
-    // Scheduled kills need a quick look at stopped children; otherwise wake every 200 ms to
-    // notice SIGINT/SIGTERM (the children get it from the terminal's process group too).
-    const auto wake = std::min(deadline, Clock::now() + (process_faults ? 2ms : 200ms));
-    std::vector<Child*> raw;
-    for (auto& c : children) raw.push_back(c.get());
-    bbw::launch::wait_any(raw, wake);
-    if (interrupted.load()) {
-      failure = std::string("interrupted by ") + (stop_signal.load() == SIGINT ? "SIGINT" : "SIGTERM");
-      break;
-    }
-    // A process that froze itself at its scheduled kill: kill it now.
-    for (auto& c : children) {
-      if (!c->take_stop()) continue;
-      const bool is_ccu = c->name() == "bbw_ccu";
-      auto& due = kills_due[is_ccu ? std::string("bbw_ccu") : corner_of(c->name())];
-      if (due.empty()) {
-        c->send_signal(SIGCONT);  // stopped by someone else: not ours to kill
-        continue;
-      }
-      const auto* kill = due.front();
-      due.erase(due.begin());
-      c->send_signal(SIGKILL);
-      c->wait_until(Clock::now() + 2000ms);
-      killed_by_schedule.insert(c.get());
-      std::cout << "bbw_launch: killed " << c->name() << " as scheduled at " << kill->at_s << " s" << std::endl;
-      if (is_ccu) {
-        ccu_killed = true;
-        ccu_killed_at_s = kill->at_s;
-        continue;
-      }
-      for (const auto& a : actions) {
-        if (a.kind == bbw::faults::ProcessAction::Kind::Restart && a.target == kill->target && a.at_s > kill->at_s) {
-          const double after_s = mode == "lockstep" ? 0.0 : a.at_s - kill->at_s;
-          restarts.push_back({corner_of(c->name()), a.at_s,
-                              Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(after_s))});
-          break;
-        }
-      }
-    }
-    for (auto it = restarts.begin(); it != restarts.end();) {
-      if (Clock::now() < it->when) {
-        ++it;
-        continue;
-      }
-      try {
-        spawn_corner(it->corner, incarnations[it->corner], it->resume_at_s);
-        std::cout << "bbw_launch: restarted corner " << it->corner << " to rejoin at " << it->resume_at_s << " s" << std::endl;
-      } catch (const std::exception& e) {
-        failure = "restart of corner " + it->corner + " failed: " + e.what();
-      }
-      it = restarts.erase(it);
-    }
-    if (!failure.empty()) break;
-    for (auto& c : children) {
-      if (!c->poll() || handled.count(c.get()) > 0) continue;
-      handled.insert(c.get());
-      if (killed_by_schedule.count(c.get()) > 0) continue;
-      const auto status = *c->status();
-      if (!status.ok()) {
-        const std::string name = c->name();
-        std::string err_file = out_dir + (name == "bbw_ccu" ? "/ccu.err" : "/corner_" + name.substr(11) + ".err");
-        failure = name + " failed: " + reason(status);
-        const std::string msg = last_line(err_file);
-        if (!msg.empty()) failure += ": " + msg;
-        break;
-      }
-    }
-    if (!failure.empty()) break;
-    bool running = false;
-    for (auto& c : children) running = running || !c->poll();
-    if (!running && restarts.empty()) break;
-    if (Clock::now() >= deadline) {
-      failure = "run exceeded its wall-time bound of " + std::to_string(static_cast<int>(bound_s)) + " s";
-      break;
-    }
+  if (!result.unreached_kill.empty()) {
+    std::cerr << "bbw_launch: " << result.unreached_kill << "\n";
+    return 1;
   }
-  if (!failure.empty()) {
-    // Which processes ended on their own (the lost ones, unless scheduled) before the others
-    // are stopped; then a partial summary from whatever each process logged.
-    std::vector<bbw::launch::ProcessEnd> ends;
-    for (auto& c : children) {
-      bbw::launch::ProcessEnd e;
-      e.name = c->name();
-      e.ended_by_itself = c->poll().has_value();
-      e.scheduled_kill = killed_by_schedule.count(c.get()) > 0;
-      ends.push_back(e);
-    }
-    for (auto& c : children) c->stop(3000ms);
-    for (std::size_t i = 0; i < children.size(); ++i) {
-      ends[i].status = children[i]->status() ? children[i]->status()->describe() : std::string("unknown");
-      ends[i].ok = children[i]->status() && children[i]->status()->ok();
-      ends[i].exit_code = children[i]->status() && children[i]->status()->exited ? children[i]->status()->code : -1;
-    }
-    const int sig = stop_signal.load();
-    std::cerr << "bbw_launch: " << failure << " (logs in " << out_dir << ")\n";
-    bbw::launch::PartialRun run;
-    run.scenario = &*scenario;
-    run.scenario_file = scenario_file;
-    run.mode = mode;
-    run.domain = domain;
-    run.run_id = run_hex;
-    run.secure = secure;
-    run.out_dir = out_dir;
-    run.failure = failure;
-    run.interrupted = sig != 0;
-    run.signal = sig;
-    run.processes = ends;
-    run.incarnations = incarnations;
-    try {
-      const auto lost = bbw::launch::write_partial_summary(run);
-      for (const auto& name : lost) std::cerr << "bbw_launch: lost process: " << name << "\n";
-      std::cerr << "bbw_launch: partial summary in " << out_dir << "/summary.json\n";
-    } catch (const std::exception& e) {
-      std::cerr << "bbw_launch: partial summary failed: " << e.what() << "\n";
-    }
-    return sig != 0 ? 128 + sig : 1;
-  }
-  for (const auto& [name, due] : kills_due) {
-    if (!due.empty()) {
-      std::cerr << "bbw_launch: the scheduled kill of " << name << " at " << due.front()->at_s
-                << " s was never reached (the process finished first)\n";
-      return 1;
-    }
-  }
-  if (ccu_killed) {
-    std::cout << "bbw_launch: the run was ended by the injected CCU kill at " << ccu_killed_at_s
+  if (result.ccu_killed) {
+    std::cout << "bbw_launch: the run was ended by the injected CCU kill at " << result.ccu_killed_at_s
               << " s; the corners ran on in their safe state" << std::endl;
   }
-  const double launch_wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
-
-  // Summary.
   try {
-    const std::string ccu_stats_file = out_dir + "/ccu.stats";
-    const auto ccu = bbw::launch::read_stats(ccu_stats_file);
-    auto num = [&](const std::map<std::string, std::string>& m, const std::string& k, const std::string& f) {
-      return bbw::launch::stat_number(m, k, f);
-    };
-    const double sim_s = num(ccu, "sim_s", ccu_stats_file);
-    const double wall_s = num(ccu, "wall_s", ccu_stats_file);
-    bbw::json::Writer j;
-    std::vector<bbw::launch::ReportCorner> report_corners;
-    long long published = 0, received = 0, gaps = 0, overruns = 0, cmd_deadlines = 0, in_flight_total = 0;
-    std::map<std::string, double> ccu_lost_s;
-    std::vector<std::vector<std::pair<double, double>>> period_logs;
-    double max_jitter = 0.0;
-    j.begin_object().value("scenario", scenario->name).value("scenario_file", scenario_file).value("mode", mode);
-    j.value("domain", domain).value("run_id", run_hex).value("friction_feedback", feedback).value("secure", secure);
-    j.value("complete", true).value("interrupted", false);
-    // Participants of other bbw runs seen on the domain (by any process of this run).
-    std::vector<bbw::dds::PeerTag> others;
-    {
-      std::vector<std::string> files{ccu_stats_file};
-      for (const auto& [c, n] : incarnations) {
-        for (unsigned k = 0; k < n; ++k) files.push_back(corner_stats_file(c, k));
-      }
-      others = bbw::launch::foreign_runs_in(files);
-    }
-    j.begin_array("other_runs_on_domain");
-    for (const auto& o : others) {
-      j.begin_object().value("run_id", bbw::dds::run_id_hex(o.run_id)).value("pid", static_cast<long long>(o.pid))
-          .value("process", o.name).end_object();
-      std::cerr << "bbw_launch: another bbw run (run id " << bbw::dds::run_id_hex(o.run_id) << ", pid " << o.pid
-                << ", " << o.name << ") is on domain " << domain << "; the run ids kept the two apart\n";
-    }
-    j.end_array();
-    j.begin_array("corners");
-    for (const auto& c : scenario->corners) {
-      // Counters summed over the corner's incarnations (a restarted process has its own file).
-      const std::string cs_file = corner_stats_file(c.name, 0);
-      const auto cs = bbw::launch::read_stats(cs_file);
-      auto corner_sum = [&](const std::string& key) {
-        double v = 0.0;
-        for (unsigned n = 0; n < incarnations[c.name]; ++n) {
-          const std::string f = corner_stats_file(c.name, n);
-          v += num(bbw::launch::read_stats(f), key, f);
-        }
-        return v;
-      };
-      auto corner_max = [&](const std::string& key) {
-        double v = 0.0;
-        for (unsigned n = 0; n < incarnations[c.name]; ++n) {
-          const std::string f = corner_stats_file(c.name, n);
-          v = std::max(v, num(bbw::launch::read_stats(f), key, f));
-        }
-        return v;
-      };
-      const auto table = bbw::csv::read(out_dir + "/ccu_" + c.name + ".csv", bbw::launch::ccu_log_columns());
-      const auto m = bbw::launch::summarize_corner(c.name, table);
-      const std::string p = c.name + ".";
-      const long long pub = static_cast<long long>(corner_sum("samples_published"));
-      // Not receivable: still held back by an injected delay, or sent after the CCU died.
-      const long long in_flight =
-          static_cast<long long>(corner_sum("samples_in_flight") + corner_sum("samples_without_ccu"));
-      const long long rec = static_cast<long long>(num(ccu, p + "samples_received", ccu_stats_file));
-      // Measurement samples missing at the CCU, measurement block numbers skipped, and commands
-      // the corner never saw (realtime: a corner follows the newest, so only the first matters
-      // for "no sample lost"); sequence_gaps is their sum.
-      const long long sample_gaps = static_cast<long long>(num(ccu, p + "sample_gaps", ccu_stats_file));
-      const long long block_gaps = static_cast<long long>(num(ccu, p + "block_gaps", ccu_stats_file));
-      const long long command_gaps = static_cast<long long>(corner_sum("command_seq_gaps"));
-      const long long g = sample_gaps + block_gaps + command_gaps;
-      published += pub;
-      in_flight_total += in_flight;
-      received += rec;
-      gaps += g;
-      overruns += static_cast<long long>(corner_sum("overruns"));
-      cmd_deadlines += static_cast<long long>(corner_sum("command_deadlines_missed"));
-      max_jitter = std::max(max_jitter, corner_max("max_jitter_s"));
-      ccu_lost_s[c.name] = num(bbw::launch::read_stats(corner_stats_file(c.name, incarnations[c.name] - 1)), "ccu_lost_s",
-                               corner_stats_file(c.name, incarnations[c.name] - 1));
-      std::vector<std::pair<double, double>> period_rows;
-      {
-        bbw::csv::ReadOptions o;
-        o.required = {"time_s", "force_true_kN"};
-        const auto t = bbw::csv::read(out_dir + "/corner_" + c.name + "_periods.csv", o);
-        for (std::size_t r = 0; r < t.rows(); ++r) period_rows.emplace_back(t.column("time_s")[r], t.column("force_true_kN")[r]);
-      }
-      period_logs.push_back(std::move(period_rows));
-      j.begin_object()
-          .value("corner", c.name)
-          .value("temperature_C", c.conditions.temperature_C)
-          .value("estimate_max_abs_error_kN", m.fused_max_abs_error_kN)
-          .value("estimate_rms_error_kN", m.fused_rms_error_kN)
-          .value("compensated_load_cell_max_abs_error_kN", m.compensated_max_abs_error_kN)
-          .value("compensated_load_cell_rms_error_kN", m.compensated_rms_error_kN)
-          .value("raw_load_cell_rms_error_kN", m.load_cell_rms_error_kN)
-          .value("samples_scored", m.samples_scored)
-          .value("force_command_samples", m.force_samples)
-          .value("tracking_max_abs_error_kN", m.tracking_max_abs_error_kN)
-          .value("tracking_rms_error_kN", m.tracking_rms_error_kN)
-          .value("tracking_steady_max_abs_error_kN", m.tracking_steady_max_abs_error_kN)
-          .value("tracking_steady_rms_error_kN", m.tracking_steady_rms_error_kN)
-          .value("fits_accepted", static_cast<long long>(num(ccu, p + "fits_accepted", ccu_stats_file)))
-          .value("fits_rejected", static_cast<long long>(num(ccu, p + "fits_rejected", ccu_stats_file)))
-          .value("first_fit_time_s", num(ccu, p + "first_fit_time_s", ccu_stats_file))
-          .value("samples_published", pub)
-          .value("samples_received", rec)
-          .value("sequence_gaps", g)
-          .value("sample_gaps", sample_gaps)
-          .value("block_gaps", block_gaps)
-          .value("command_gaps", command_gaps)
-          .value("samples_suppressed_by_fault", static_cast<long long>(corner_sum("samples_suppressed")))
-          .value("samples_not_receivable", in_flight)
-          .value("incarnations", static_cast<long long>(incarnations[c.name]))
-          .value("rejoins", static_cast<long long>(num(ccu, p + "rejoins", ccu_stats_file)))
-          .value("samples_rejected_by_guard", static_cast<long long>(num(ccu, p + "guard_rejected", ccu_stats_file)))
-          .value("calibrator_restarts", static_cast<long long>(num(ccu, p + "calibrator_restarts", ccu_stats_file)))
-          .value("measurement_deadline_misses", static_cast<long long>(num(ccu, p + "deadlines_missed", ccu_stats_file)))
-          .value("measurement_liveliness_lost", static_cast<long long>(num(ccu, p + "liveliness_lost", ccu_stats_file)))
-          .value("command_deadline_misses", static_cast<long long>(corner_sum("command_deadlines_missed")))
-          .value("ccu_lost_detected_s", ccu_lost_s[c.name])
-          .value("max_jitter_s", corner_max("max_jitter_s"))
-          .value("mean_jitter_s", num(cs, "mean_jitter_s", cs_file))
-          .value("overruns", static_cast<long long>(corner_sum("overruns")))
-          .value("commands_clamped", static_cast<long long>(corner_sum("commands_clamped")))
-          .value("commands_refused_run", static_cast<long long>(corner_sum("commands_refused_run")))
-          .value("commands_refused_source", static_cast<long long>(corner_sum("commands_refused_source")))
-          .value("commands_refused_value", static_cast<long long>(corner_sum("commands_refused_value")))
-          .end_object();
-      bbw::launch::ReportCorner rc;
-      rc.summary = m;
-      rc.calibrated = num(ccu, p + "fits_accepted", ccu_stats_file) > 0;
-      rc.curve = {num(ccu, p + "curve_a", ccu_stats_file), num(ccu, p + "curve_b", ccu_stats_file),
-                  num(ccu, p + "curve_c", ccu_stats_file), num(ccu, p + "curve_d", ccu_stats_file)};
-      report_corners.push_back(rc);
-    }
-    j.end_array();
-    j.begin_object("run")
-        .value("mode", mode)
-        .value("simulated_s", sim_s)
-        .value("wall_s", wall_s)
-        .value("launch_wall_s", launch_wall_s)
-        .value("real_time_factor", wall_s > 0.0 ? sim_s / wall_s : 0.0)
-        .value("samples_published", published)
-        .value("samples_received", received)
-        .value("samples_lost", published - received - in_flight_total)
-        .value("ended_by_injected_ccu_kill", ccu_killed)
-        .value("sequence_gaps", gaps)
-        .value("measurement_deadline_misses", static_cast<long long>(num(ccu, "measurement_deadlines_missed", ccu_stats_file)))
-        .value("measurement_liveliness_lost", static_cast<long long>(num(ccu, "measurement_liveliness_lost", ccu_stats_file)))
-        .value("command_deadline_misses", cmd_deadlines)
-        .value("max_jitter_s", max_jitter)
-        .value("overruns", overruns)
-        .value("foreign_run_samples", static_cast<long long>(num(ccu, "foreign_run_samples", ccu_stats_file)))
-        .end_object();
-    // Injected faults against what was detected, and the total clamp force against demand.
-    const auto timeline = bbw::launch::build_timeline(*scenario, period_logs);
-    const auto detections = bbw::launch::read_detections(ccu, ccu_stats_file);
-    const auto faults = bbw::launch::assess_faults(schedule, detections, ccu_lost_s, timeline, scenario->duration_s);
-    j.begin_array("faults");
-    for (const auto& f : faults) {
-      j.begin_object()
-          .value("corner", std::string(bbw::faults::to_string(f.fault.target)))
-          .value("part", std::string(bbw::faults::to_string(f.fault.part)))
-          .value("type", std::string(bbw::faults::to_string(f.fault.type)))
-          .value("injected_s", f.fault.at_s)
-          .value("ends_s", std::min(f.fault.end_s(), scenario->duration_s))
-          .value("detected", f.detected)
-          .value("detected_s", f.detected ? f.detected_s : -1.0)
-          .value("latency_ms", f.detected ? f.latency_ms : -1.0)
-          .value("diagnosis", f.diagnosis)
-          .value("diagnosis_s", f.detected ? f.diagnosis_s : -1.0)
-          .value("diagnosis_latency_ms", f.detected ? f.diagnosis_latency_ms : -1.0)
-          .value("correct", f.correct)
-          .value("reaction", f.reaction)
-          .value("delivered_share", f.delivered_share)
-          .end_object();
-    }
-    j.end_array();
-    j.begin_array("detections");
-    for (const auto& d : detections) {
-      j.begin_object()
-          .value("corner", d.corner)
-          .value("part", d.part)
-          .value("finding", d.finding)
-          .value("onset_s", d.onset_s)
-          .value("detected_s", d.detected_s)
-          .end_object();
-    }
-    j.end_array();
-    j.end_object();
-    j.save(out_dir + "/summary.json");
-    {
-      std::ofstream tl(out_dir + "/timeline.csv");
-      tl << "time_s,demand_total_kN,delivered_total_kN\n";
-      for (const auto& p : timeline) tl << p.time_s << ',' << p.demand_kN << ',' << p.delivered_kN << '\n';
-      if (!tl) throw std::runtime_error(out_dir + "/timeline.csv: cannot write");
-    }
-    if (report) {
-      bbw::launch::write_report(out_dir, "bbw run: " + scenario->name + " (" + mode + ")", report_corners, j.str(),
-                                &faults, &detections);
-    }
-    std::cout << "bbw_launch: done: simulated " << sim_s << " s in " << wall_s << " s (real-time factor "
-              << (wall_s > 0 ? sim_s / wall_s : 0.0) << "), samples published " << published << ", received "
-              << received << ", gaps " << gaps << "; " << out_dir << "/summary.json" << std::endl;
+    bbw::launch::CompletedRun run;
+    run.scenario = plan.scenario;
+    run.schedule = plan.schedule;
+    run.scenario_file = plan.scenario_file;
+    run.mode = plan.mode;
+    run.run_id = plan.run_id;
+    run.out_dir = plan.out_dir;
+    run.friction_feedback = plan.friction_feedback;
+    run.domain = domain;
+    run.secure = plan.secure;
+    run.report = opt.report;
+    run.incarnations = result.incarnations;
+    run.ended_by_injected_ccu_kill = result.ccu_killed;
+    run.launch_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    const auto t = bbw::launch::write_run_summary(run);
+    std::cout << "bbw_launch: done: simulated " << t.simulated_s << " s in " << t.wall_s << " s (real-time factor "
+              << (t.wall_s > 0 ? t.simulated_s / t.wall_s : 0.0) << "), samples published " << t.published
+              << ", received " << t.received << ", gaps " << t.gaps << "; " << plan.out_dir << "/summary.json"
+              << std::endl;
   } catch (const std::exception& e) {
     std::cerr << "bbw_launch: summary failed: " << e.what() << "\n";
     return 1;

@@ -5,9 +5,10 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <optional>
 
 #include "bbw/common/json.hpp"
-#include "bbw/launch/stats_file.hpp"
+#include "bbw/runtime/run_stats.hpp"
 #include "summary.hpp"
 
 namespace bbw::launch {
@@ -16,25 +17,22 @@ namespace {
 
 constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
 
-// The stats of a process, or empty when it left none (killed before writing them).
-std::map<std::string, std::string> stats_or_empty(const std::string& file) {
+// The stats of a process, or none when it left none (killed before writing them) or they do
+// not parse (a cut file).
+std::optional<runtime::CcuRunStats> ccu_stats_or_none(const std::string& file) {
   try {
-    return read_stats(file);
+    return runtime::load_ccu_stats(file);
   } catch (const std::exception&) {
-    return {};
+    return std::nullopt;
   }
 }
 
-double number_or_none(const std::map<std::string, std::string>& m, const std::string& key) {
+std::optional<runtime::CornerRunStats> corner_stats_or_none(const std::string& file) {
   try {
-    return stat_number(m, key, "");
+    return runtime::load_corner_stats(file);
   } catch (const std::exception&) {
-    return kNone;
+    return std::nullopt;
   }
-}
-
-std::string corner_stats_file(const std::string& out, const std::string& c, unsigned n) {
-  return out + "/corner_" + c + (n == 0 ? "" : "." + std::to_string(n)) + ".stats";
 }
 
 }  // namespace
@@ -52,10 +50,12 @@ std::vector<std::string> lost_processes(const PartialRun& run) {
 std::vector<dds::PeerTag> foreign_runs_in(const std::vector<std::string>& stats_files) {
   std::vector<dds::PeerTag> out;
   for (const auto& f : stats_files) {
-    const auto m = stats_or_empty(f);
-    const auto it = m.find("foreign_runs");
-    if (it == m.end()) continue;
-    for (const auto& t : dds::split_peer_tags(it->second)) {
+    // Either kind of stats file: the CCU's, or a corner's.
+    std::string tags;
+    if (const auto c = ccu_stats_or_none(f)) tags = c->foreign_runs;
+    else if (const auto k = corner_stats_or_none(f)) tags = k->foreign_runs;
+    else continue;
+    for (const auto& t : dds::split_peer_tags(tags)) {
       bool seen = false;
       for (const auto& o : out) seen = seen || (o.run_id == t.run_id && o.pid == t.pid);
       if (!seen) out.push_back(t);
@@ -67,7 +67,15 @@ std::vector<dds::PeerTag> foreign_runs_in(const std::vector<std::string>& stats_
 std::vector<std::string> write_partial_summary(const PartialRun& run) {
   const std::vector<std::string> lost = lost_processes(run);
   const std::string ccu_file = run.out_dir + "/ccu.stats";
-  const auto ccu = stats_or_empty(ccu_file);
+  const auto ccu = ccu_stats_or_none(ccu_file);
+  // The CCU's entry of a corner, when it logged one.
+  auto ccu_corner = [&](const std::string& name) -> const runtime::CcuCornerStats* {
+    if (!ccu) return nullptr;
+    for (const auto& c : ccu->corners) {
+      if (c.corner == name) return &c;
+    }
+    return nullptr;
+  };
   json::Writer j;
   j.begin_object()
       .value("scenario", run.scenario->name)
@@ -102,18 +110,17 @@ std::vector<std::string> write_partial_summary(const PartialRun& run) {
     for (unsigned k = 0; k < n; ++k) {
       const std::string f = corner_stats_file(run.out_dir, c.name, k);
       stats_files.push_back(f);
-      const auto m = stats_or_empty(f);
-      if (m.empty()) continue;
+      const auto m = corner_stats_or_none(f);
+      if (!m) continue;
       ++with_stats;
-      periods += number_or_none(m, "periods");
-      published += number_or_none(m, "samples_published");
-      applied += number_or_none(m, "commands_applied");
-      clamped += number_or_none(m, "commands_clamped");
-      refused += number_or_none(m, "commands_refused_run") + number_or_none(m, "commands_refused_source") +
-                 number_or_none(m, "commands_refused_value");
+      periods += static_cast<double>(m->periods);
+      published += static_cast<double>(m->samples_published);
+      applied += static_cast<double>(m->commands_applied);
+      clamped += static_cast<double>(m->commands_clamped);
+      refused += static_cast<double>(m->commands_refused_run + m->commands_refused_source + m->commands_refused_value);
     }
     const bool have = with_stats > 0;
-    const std::string p = c.name + ".";
+    const runtime::CcuCornerStats* at_ccu = ccu_corner(c.name);
     j.begin_object()
         .value("corner", c.name)
         .value("stats_logged", have)
@@ -122,23 +129,28 @@ std::vector<std::string> write_partial_summary(const PartialRun& run) {
         .value("commands_applied", have ? applied : kNone)
         .value("commands_clamped", have ? clamped : kNone)
         .value("commands_refused", have ? refused : kNone)
-        .value("samples_received", number_or_none(ccu, p + "samples_received"))
-        .value("sample_gaps", number_or_none(ccu, p + "sample_gaps"));
+        .value("samples_received", at_ccu ? static_cast<double>(at_ccu->samples_received) : kNone)
+        .value("sample_gaps", at_ccu ? static_cast<double>(at_ccu->sample_gaps) : kNone);
     // The CCU's per-sample log as far as it was written (a killed CCU may leave a cut line).
     const std::string log = run.out_dir + "/ccu_" + c.name + ".csv";
     std::string log_state = "missing";
     double max_err = kNone, scored = kNone;
+    std::string why = "the CCU's log of this corner is " + log_state;
     if (std::filesystem::exists(log)) {
       try {
         const CornerSummary s = summarize_corner(c.name, csv::read(log, ccu_log_columns()));
         scored = static_cast<double>(s.samples_scored);
-        if (s.samples_scored > 0) max_err = s.fused_max_abs_error_kN;
+        max_err = s.fused_max_abs_error_kN;  // NaN (null) when nothing was scored
+        why = not_scored_reason(s, at_ccu ? static_cast<long long>(at_ccu->fits_accepted) : 1);
         log_state = "read";
       } catch (const std::exception& e) {
         log_state = std::string("unreadable: ") + e.what();
+        why = "the CCU's log of this corner is " + log_state;
       }
     }
     j.value("ccu_log", log_state).value("samples_scored", scored).value("estimate_max_abs_error_kN", max_err);
+    if (why.empty()) j.value("not_scored_reason", kNone);
+    else j.value("not_scored_reason", why);
     j.end_object();
   }
   j.end_array();
@@ -148,7 +160,7 @@ std::vector<std::string> write_partial_summary(const PartialRun& run) {
         .value("process", o.name).end_object();
   }
   j.end_array();
-  j.value("ccu_stats_logged", !ccu.empty());
+  j.value("ccu_stats_logged", ccu.has_value());
   j.end_object();
   j.save(run.out_dir + "/summary.json");
   return lost;

@@ -87,9 +87,15 @@ void write_report(const std::string& dir, const std::string& title, const std::v
   for (const auto& rc : corners) {
     const auto& m = rc.summary;
     char row[512];
+    char est[128];
+    if (m.samples_scored > 0) {
+      std::snprintf(est, sizeof(est), "%.3f / %.3f</td><td>%.3f", m.fused_max_abs_error_kN, m.fused_rms_error_kN,
+                    m.load_cell_rms_error_kN);
+    } else {
+      std::snprintf(est, sizeof(est), "(not scored)</td><td>(not scored)");
+    }
     std::snprintf(row, sizeof(row),
-                  "<tr><td>%s</td><td>%.3f / %.3f</td><td>%.3f</td><td>%s</td></tr>\n", m.corner.c_str(),
-                  m.fused_max_abs_error_kN, m.fused_rms_error_kN, m.load_cell_rms_error_kN,
+                  "<tr><td>%s</td><td>%s</td><td>%s</td></tr>\n", m.corner.c_str(), est,
                   m.force_samples > 0
                       ? (std::to_string(m.tracking_max_abs_error_kN).substr(0, 6) + " / " +
                          std::to_string(m.tracking_rms_error_kN).substr(0, 6)).c_str()
@@ -110,7 +116,7 @@ void write_report(const std::string& dir, const std::string& title, const std::v
                     faults::to_string(r.fault.target), faults::to_string(r.fault.part), faults::to_string(r.fault.type),
                     r.fault.at_s, r.detected ? std::to_string(r.detected_s).c_str() : "-",
                     r.detected ? std::to_string(r.latency_ms).substr(0, 6).c_str() : "-",
-                    html_escape(r.diagnosis).c_str(), r.correct ? "yes" : "no", html_escape(r.reaction).c_str(),
+                    html_escape(faults::diagnosis_name(r)).c_str(), r.correct ? "yes" : "no", html_escape(r.reaction).c_str(),
                     r.delivered_share);
       f << row;
     }

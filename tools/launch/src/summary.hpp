@@ -3,13 +3,18 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "bbw/common/csv.hpp"
+#include "bbw/faults/schedule.hpp"
+#include "bbw/scenario/scenario.hpp"
 
 namespace bbw::launch {
 
+// Errors over no sample are NaN (written as null in summary.json), never 0: a reason says why
+// (not_scored_reason, tracking_not_scored_reason).
 struct CornerSummary {
   std::string corner;
   std::size_t samples = 0;
@@ -34,5 +39,40 @@ struct CornerSummary {
 CornerSummary summarize_corner(const std::string& corner, const csv::Table& log);
 
 csv::ReadOptions ccu_log_columns();
+
+// Why the estimate errors are null ("" when samples were scored). `fits_accepted`: the CCU's
+// count for the corner (a corner that was never calibrated has no valid estimate to score).
+std::string not_scored_reason(const CornerSummary& s, long long fits_accepted);
+// Why the tracking errors (all force-command samples, or the holds) are null ("" when both were scored).
+std::string tracking_not_scored_reason(const CornerSummary& s);
+
+// What the launcher knows of a run whose processes all ended as planned.
+struct CompletedRun {
+  const scenario::Scenario* scenario = nullptr;
+  const faults::FaultSchedule* schedule = nullptr;
+  std::string scenario_file, mode, run_id, out_dir, friction_feedback;
+  int domain = 0;
+  bool secure = false;
+  bool report = true;                            // also write report.html
+  std::map<std::string, unsigned> incarnations;  // corner -> processes started
+  bool ended_by_injected_ccu_kill = false;
+  double launch_wall_s = 0.0;
+};
+
+// "" for a corner's first process, ".<n>" for its incarnation n (file and process names).
+std::string incarnation_suffix(unsigned n);
+// OUT/corner_<C>[.<n>].stats of a corner's incarnation n (0: the first process).
+std::string corner_stats_file(const std::string& out_dir, const std::string& corner, unsigned incarnation);
+
+// The totals the launcher prints at the end.
+struct RunTotals {
+  double simulated_s = 0.0, wall_s = 0.0;
+  long long published = 0, received = 0, gaps = 0;
+};
+
+// Writes OUT/summary.json (complete run), OUT/timeline.csv and, if asked, OUT/report.html from
+// the processes' stats files (bbw/runtime/run_stats.hpp) and logs. Errors over no sample are
+// null with a reason, never 0. Throws std::runtime_error naming the file (and key) at fault.
+RunTotals write_run_summary(const CompletedRun& run);
 
 }  // namespace bbw::launch

@@ -11,7 +11,7 @@
 #include <functional>
 #include <thread>
 
-namespace bbw::launch {
+namespace bbw::runtime {
 
 class SignalWatcher {
  public:
@@ -30,4 +30,4 @@ class SignalWatcher {
   std::thread thread_;
 };
 
-}  // namespace bbw::launch
+}  // namespace bbw::runtime

@@ -1,4 +1,4 @@
-#include "bbw/dds/process_cli.hpp"
+#include "bbw/runtime/process_cli.hpp"
 
 #include <cstdio>
 #include <cstdlib>
@@ -7,7 +7,7 @@
 #include "bbw/dds/domain.hpp"
 #include "bbw/dds/run_id.hpp"
 
-namespace bbw::dds {
+namespace bbw::runtime {
 
 const std::string& ArgCursor::flag() {
   flag_ = argv_[i_++];
@@ -48,7 +48,7 @@ bool ProcessFlags::take(const std::string& flag, ArgCursor& args) {
   else if (flag == "--process-faults") options.process_faults = true;
   else if (flag == "--run-id") {
     const std::string text = args.value();
-    const auto id = parse_run_id(text);
+    const auto id = dds::parse_run_id(text);
     if (!id) throw std::invalid_argument("--run-id must be 1 to 16 hex digits, got '" + text + "'");
     options.participant.run_id = *id;
   }
@@ -58,7 +58,7 @@ bool ProcessFlags::take(const std::string& flag, ArgCursor& args) {
 
 void ProcessFlags::finish(const char* env_domain) {
   if (scenario_file.empty()) throw std::invalid_argument("--scenario is required");
-  options.participant.domain_id = resolve_domain_id(domain_arg, env_domain);
+  options.participant.domain_id = dds::resolve_domain_id(domain_arg, env_domain);
 }
 
 std::string process_usage(const std::string& program, const std::string& lead,
@@ -71,4 +71,4 @@ std::string process_usage(const std::string& program, const std::string& lead,
   return text;
 }
 
-}  // namespace bbw::dds
+}  // namespace bbw::runtime

@@ -10,7 +10,7 @@
 
 #include "bbw/dds/participant.hpp"
 
-namespace bbw::dds {
+namespace bbw::runtime {
 
 enum class ClockMode { Lockstep, Realtime };
 
@@ -48,7 +48,7 @@ ClockMode parse_clock_mode(const std::string& text);
 // The options both processes run with (CcuOptions and CornerOptions extend them).
 struct ProcessOptions {
   ClockMode mode = ClockMode::Lockstep;
-  ParticipantOptions participant;
+  dds::ParticipantOptions participant;
   std::chrono::milliseconds discovery_timeout{20000};
   // Lockstep: the longest wait for the peer's next block (CCU) or command (corner).
   std::chrono::milliseconds peer_timeout{10000};
@@ -75,4 +75,4 @@ struct ProcessFlags {
 std::string process_usage(const std::string& program, const std::string& lead,
                           const std::vector<std::string>& own_lines);
 
-}  // namespace bbw::dds
+}  // namespace bbw::runtime

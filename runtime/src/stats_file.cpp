@@ -1,24 +1,11 @@
-#include "bbw/launch/stats_file.hpp"
+#include "bbw/runtime/stats_file.hpp"
 
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <stdexcept>
 
-namespace bbw::launch {
-
-void StatsWriter::set(const std::string& key, double value) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.17g", value);
-  set(key, std::string(buf));
-}
-
-void StatsWriter::save(const std::string& file) const {
-  std::ofstream f(file);
-  if (!f) throw std::runtime_error(file + ": cannot write");
-  for (const auto& [k, v] : lines_) f << k << '=' << v << '\n';
-  if (!f) throw std::runtime_error(file + ": write error");
-}
+namespace bbw::runtime {
 
 std::map<std::string, std::string> read_stats(const std::string& file) {
   std::ifstream f(file);
@@ -50,4 +37,4 @@ double stat_number(const std::map<std::string, std::string>& stats, const std::s
   return v;
 }
 
-}  // namespace bbw::launch
+}  // namespace bbw::runtime

@@ -1,10 +1,10 @@
-#include "bbw/launch/signals.hpp"
+#include "bbw/runtime/signals.hpp"
 
 #include <signal.h>
 
 #include <stdexcept>
 
-namespace bbw::launch {
+namespace bbw::runtime {
 
 namespace {
 sigset_t watched() {
@@ -41,4 +41,4 @@ SignalWatcher::~SignalWatcher() {
   thread_.join();
 }
 
-}  // namespace bbw::launch
+}  // namespace bbw::runtime

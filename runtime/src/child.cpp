@@ -1,4 +1,4 @@
-#include "bbw/launch/child.hpp"
+#include "bbw/runtime/child.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -14,7 +14,7 @@
 
 extern char** environ;
 
-namespace bbw::launch {
+namespace bbw::runtime {
 
 namespace {
 
@@ -179,4 +179,4 @@ std::string executable_dir() {
   return slash == std::string::npos ? "." : path.substr(0, slash);
 }
 
-}  // namespace bbw::launch
+}  // namespace bbw::runtime

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace bbw::launch {
+namespace bbw::runtime {
 
 using Clock = std::chrono::steady_clock;
 
@@ -63,4 +63,4 @@ int wait_any(const std::vector<Child*>& children, Clock::time_point deadline);
 // The directory holding the running executable (for sibling binaries such as bbw_corner).
 std::string executable_dir();
 
-}  // namespace bbw::launch
+}  // namespace bbw::runtime

@@ -1,0 +1,66 @@
+#include "options.hpp"
+
+#include <cstdlib>
+#include <stdexcept>
+
+#include "bbw/dds/domain.hpp"
+#include "bbw/runtime/process_cli.hpp"
+#include "bbw/faults/link_faults.hpp"
+#include "bbw/faults/schedule_yaml.hpp"
+#include "bbw/scenario/load.hpp"
+#include "bbw/scenario/run_checks.hpp"
+
+namespace bbw::launch {
+
+const char* const kUsage =
+    "usage: bbw_launch SCENARIO.yaml --out DIR [--mode lockstep|realtime] [--domain N]\n"
+    "                  [--discovery-timeout S] [--friction-feedback on|off] [--no-report]\n"
+    "                  [--secure [--keys DIR]] [--allow-large]\n";
+
+Options parse_options(int argc, char** argv) {
+  Options o;
+  for (runtime::ArgCursor args(argc, argv); !args.done();) {
+    const std::string k = args.flag();
+    auto next = [&] { return args.value(); };
+    if (k == "--out") o.out_dir = next();
+    else if (k == "--mode") runtime::parse_clock_mode(o.mode = next());
+    else if (k == "--domain") o.domain_arg = next();
+    else if (k == "--discovery-timeout") {
+      o.discovery_s = static_cast<double>(runtime::seconds_arg(k, next(), 600.0).count()) / 1000.0;
+    } else if (k == "--friction-feedback") o.friction_feedback = next();
+    else if (k == "--no-report") o.report = false;
+    else if (k == "--secure") o.secure = true;
+    else if (k == "--keys") o.keys_dir = next();
+    else if (k == "--allow-large") o.allow_large = true;
+    else if (k == "-h" || k == "--help") {
+      o.help = true;
+      return o;
+    } else if (!k.empty() && k[0] == '-') throw std::invalid_argument("unknown argument '" + k + "'");
+    else if (o.scenario_file.empty()) o.scenario_file = k;
+    else throw std::invalid_argument("unexpected argument '" + k + "'");
+  }
+  if (o.scenario_file.empty()) throw std::invalid_argument("a scenario file is required");
+  if (o.out_dir.empty()) throw std::invalid_argument("--out DIR is required");
+  if (o.friction_feedback != "on" && o.friction_feedback != "off") {
+    throw std::invalid_argument("--friction-feedback must be on or off");
+  }
+  return o;
+}
+
+int requested_domain(const Options& o) { return dds::resolve_domain_id(o.domain_arg, std::getenv("BBW_DOMAIN"), -1); }
+
+LoadedRun load_run(const Options& o) {
+  auto fs = faults::load_fault_scenario(o.scenario_file);
+  LoadedRun r{std::move(fs.scenario), std::move(fs.faults)};
+  scenario::check_four_corner_run(r.scenario);
+  if (!o.allow_large) scenario::check_run_size(r.scenario);
+  for (const auto& a : faults::process_actions(r.schedule)) {
+    if (a.target == faults::Target::CCU && a.kind == faults::ProcessAction::Kind::Restart) {
+      throw std::invalid_argument(o.scenario_file +
+                                  ": restarting the CCU is not supported over DDS (a kill of the CCU ends the run)");
+    }
+  }
+  return r;
+}
+
+}  // namespace bbw::launch
