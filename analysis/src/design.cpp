@@ -60,9 +60,13 @@ Vec effective_position(const Context& c, const Spec& s) {
 Design build(const Context& c, const Spec& s) {
   Design d;
   d.x_eff = effective_position(c, s);
-  const auto m = static_cast<std::size_t>(c.opt.elements_M);
-  d.deltas.resize(m);
-  calibration::thresholds(m, s.delta_max, true, c.opt.geometric_ratio, d.deltas.data());
+  if (c.opt.friction_thresholds.empty()) {
+    d.deltas.resize(static_cast<std::size_t>(c.opt.elements_M));
+    calibration::thresholds(d.deltas.size(), s.delta_max, true, c.opt.geometric_ratio, d.deltas.data());
+  } else {
+    d.deltas = c.opt.friction_thresholds;  // the online calibrator's element set
+  }
+  const std::size_t m = d.deltas.size();
   std::vector<Vec> nreg;
   maxwell_slip_regressors(d.x_eff, d.deltas, nreg);
   std::vector<std::vector<Vec>> extra;

@@ -10,6 +10,7 @@
 namespace bbw::analysis::detail {
 
 double choose_delta_max(const Context& c, Spec s) {
+  if (!c.opt.friction_thresholds.empty()) return c.opt.friction_thresholds.back();  // fixed, as online
   double best = std::numeric_limits<double>::infinity();
   double best_dm = c.opt.delta_max_fractions.front() * c.xrange;
   for (double f : c.opt.delta_max_fractions) {

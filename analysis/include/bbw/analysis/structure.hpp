@@ -7,7 +7,8 @@
 
 namespace bbw::analysis::detail {
 
-// Delta_max on the grid of fractions of the position range, by the fit-part RMS.
+// Delta_max: the largest of options.friction_thresholds (the online calibrator's element set)
+// when given, else chosen on the grid of fractions of the position range by the fit-part RMS.
 double choose_delta_max(const Context& c, Spec s);
 // Chooses the curve's knots (fewest within tolerance of the best held-out RMS) and Delta_max
 // (fit-part RMS) for the model `s` otherwise as it is.
