@@ -60,6 +60,7 @@ Vec effective_position(const Context& c, const Spec& s) {
 Design build(const Context& c, const Spec& s) {
   Design d;
   d.x_eff = effective_position(c, s);
+  d.first_known = calibration::first_known_sample(d.x_eff.data(), c.n, s.delta_max);
   if (c.opt.friction_thresholds.empty()) {
     d.deltas.resize(static_cast<std::size_t>(c.opt.elements_M));
     calibration::thresholds(d.deltas.size(), s.delta_max, true, c.opt.geometric_ratio, d.deltas.data());
@@ -112,8 +113,14 @@ Design build(const Context& c, const Spec& s) {
   return d;
 }
 
+std::vector<Index> fit_rows(const Design& d, const std::vector<Index>& rows) {
+  const auto from = std::lower_bound(rows.begin(), rows.end(), static_cast<Index>(d.first_known));
+  if (rows.end() - from < 2 * d.x.cols()) return rows;
+  return std::vector<Index>(from, rows.end());
+}
+
 Eigen::VectorXd fit(const Context& c, const Design& d, const std::vector<Index>& rows) {
-  return solve_bounded(normal_equations(d.x, c.y, rows), d.nonneg);
+  return solve_bounded(normal_equations(d.x, c.y, fit_rows(d, rows)), d.nonneg);
 }
 
 Evaluated evaluate(const Context& c, const Spec& s, Design d, const Eigen::VectorXd& coef) {
@@ -121,10 +128,10 @@ Evaluated evaluate(const Context& c, const Spec& s, Design d, const Eigen::Vecto
   ev.coef = coef;
   ev.residual = c.y - d.x * coef;
   ErrorFigures& e = ev.errors;
-  std::vector<Index> all(c.n);
-  std::iota(all.begin(), all.end(), Index{0});
-  e.rms_residual = rms_of(ev.residual, all);
-  const std::size_t first = std::min(calibration::first_known_sample(d.x_eff.data(), c.n, s.delta_max), c.n - 1);
+  const std::size_t first = std::min(d.first_known, c.n - 1);
+  std::vector<Index> scored(c.n - first);
+  std::iota(scored.begin(), scored.end(), static_cast<Index>(first));
+  e.rms_residual = rms_of(ev.residual, scored);
   e.unscored_initial_samples = first;
   e.max_residual = ev.residual.tail(static_cast<Index>(c.n - first)).cwiseAbs().maxCoeff();
   e.holdout_rms_residual = rms_of(ev.residual, c.holdout);
@@ -165,8 +172,9 @@ Evaluated evaluate(const Context& c, const Spec& s, Design d, const Eigen::Vecto
 
 double search_rms(const Context& c, const Spec& s) {
   const Design d = build(c, s);
-  const Eigen::VectorXd b = fit(c, d, c.train_search);
-  return rms_of(c.y - d.x * b, c.train_search);
+  const std::vector<Index> rows = fit_rows(d, c.train_search);
+  const Eigen::VectorXd b = solve_bounded(normal_equations(d.x, c.y, rows), d.nonneg);
+  return rms_of(c.y - d.x * b, rows);
 }
 
 void update_refs(Context& c, const Evaluated& ev) {

@@ -130,14 +130,15 @@ void split_uncertainty(const Context& c, const Spec& s, const Evaluated& ev, Ste
   }
   if (offset_col < 0 || offset_col + 2 >= d.x.cols()) return;
   const Index shift_col = offset_col + 2;  // columns: offset, gain, shift
-  const LsqProblem p = normal_equations(d.x, c.y, c.train);
+  const std::vector<Index> rows = fit_rows(d, c.train);
+  const LsqProblem p = normal_equations(d.x, c.y, rows);
   const Eigen::VectorXd scale = p.gram.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
   const Eigen::MatrixXd g = scale.asDiagonal() * p.gram * scale.asDiagonal();
   const Eigen::MatrixXd inv = g.ldlt().solve(Eigen::MatrixXd::Identity(g.rows(), g.cols()));
   const double corr = inv(offset_col, shift_col) / std::sqrt(inv(offset_col, offset_col) * inv(shift_col, shift_col));
   double rss = 0.0;
-  for (Index k : c.train) rss += ev.residual(k) * ev.residual(k);
-  const double dof = std::max(1.0, static_cast<double>(c.train.size()) - static_cast<double>(d.x.cols()));
+  for (Index k : rows) rss += ev.residual(k) * ev.residual(k);
+  const double dof = std::max(1.0, static_cast<double>(rows.size()) - static_cast<double>(d.x.cols()));
   st.offset_shift_correlation = std::isfinite(corr) ? corr : 1.0;
   st.offset_standard_error = std::sqrt(rss / dof * inv(offset_col, offset_col)) * scale(offset_col);
   st.ambiguous = std::abs(st.offset_shift_correlation) >= AnalysisResult::kAmbiguousCorrelation;

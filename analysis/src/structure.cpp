@@ -56,7 +56,10 @@ void choose_curve(const Context& c, Spec& spec) {
 void test_structure(const Context& c, AnalysisResult& res) {
   const Recording& rec = c.rec;
   const AnalysisOptions& opt = c.opt;
-  const Vec& r = res.residual_after;
+  // Scored samples only: before the element states are known the rows are not fitted.
+  const std::size_t first = std::min(res.final_errors.unscored_initial_samples, c.n - 1);
+  const auto scored = [first](const Vec& v) { return Vec(v.begin() + static_cast<std::ptrdiff_t>(first), v.end()); };
+  const Vec r = scored(res.residual_after);
   const WhitenessTest w = whiteness(r, opt.ljung_box_lags);
   {
     StructureFinding f;
@@ -70,7 +73,7 @@ void test_structure(const Context& c, AnalysisResult& res) {
     res.structure.push_back(f);
   }
   auto dep = [&](const Vec& by, const std::string& name) {
-    const DependenceTest t = dependence(r, by, opt.structure_bins, name);
+    const DependenceTest t = dependence(r, scored(by), opt.structure_bins, name);
     StructureFinding f;
     f.test = name;
     f.statistic = t.f_statistic;

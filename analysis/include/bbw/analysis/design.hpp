@@ -40,6 +40,9 @@ struct Design {
   std::vector<int> owner;  // -2 curve, -1 friction, >= 0 index into Spec::columns
   Vec deltas;
   Vec x_eff;
+  // The first sample at which the element states are known (calibration::StatesKnown on x_eff
+  // with the largest threshold; n when never): rows before it are neither fitted nor scored.
+  std::size_t first_known = 0;
 };
 
 struct Context {
@@ -72,6 +75,11 @@ std::vector<Vec> column_values(const Context& c, const ColumnEffect& e);
 // The position the model sees: delayed and/or through the play operator.
 Vec effective_position(const Context& c, const Spec& s);
 Design build(const Context& c, const Spec& s);
+// The rows of `rows` (ascending) the fit uses: those from d.first_known on, as the online
+// calibrator starts no cycle before its element states are known; all of `rows` when fewer
+// than twice the model's columns would be left (a recording that never travels 2 Delta_max).
+std::vector<Index> fit_rows(const Design& d, const std::vector<Index>& rows);
+// The bounded least-squares fit on fit_rows(d, rows).
 Eigen::VectorXd fit(const Context& c, const Design& d, const std::vector<Index>& rows);
 // Residual, error figures (scored samples only) and the estimate's error against the truth.
 Evaluated evaluate(const Context& c, const Spec& s, Design d, const Eigen::VectorXd& coef);

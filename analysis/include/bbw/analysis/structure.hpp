@@ -13,7 +13,8 @@ double choose_delta_max(const Context& c, Spec s);
 // Chooses the curve's knots (fewest within tolerance of the best held-out RMS) and Delta_max
 // (fit-part RMS) for the model `s` otherwise as it is.
 void choose_curve(const Context& c, Spec& spec);
-// Whiteness and dependence tests of res.residual_after: fills res.structure,
+// Whiteness and dependence tests of res.residual_after over the scored samples (from
+// res.final_errors.unscored_initial_samples on): fills res.structure,
 // res.unexplained_structure and res.structure_notes.
 void test_structure(const Context& c, AnalysisResult& res);
 
