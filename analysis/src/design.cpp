@@ -134,7 +134,7 @@ Evaluated evaluate(const Context& c, const Spec& s, Design d, const Eigen::Vecto
   e.rms_residual = rms_of(ev.residual, scored);
   e.unscored_initial_samples = first;
   e.max_residual = ev.residual.tail(static_cast<Index>(c.n - first)).cwiseAbs().maxCoeff();
-  e.holdout_rms_residual = rms_of(ev.residual, c.holdout);
+  e.holdout_rms_residual = rms_of(ev.residual, fit_rows(d, c.holdout));
   if (!c.rec.truth.empty()) {
     e.has_truth = true;
     // Estimate: the reading minus the terms attributed to the sensor.

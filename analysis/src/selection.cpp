@@ -108,9 +108,10 @@ Scored score_candidate(const Context& c, const Spec& s, const Candidate& cand, c
   const Design d = build(c, out.spec);
   const Eigen::VectorXd b = fit(c, d, c.train);
   const Eigen::VectorXd r = c.y - d.x * b;
-  out.score.holdout_rms = rms_of(r, c.holdout);
+  const std::vector<Index> held = fit_rows(d, c.holdout);  // states known
+  out.score.holdout_rms = rms_of(r, held);
   out.score.relative_drop = 1.0 - out.score.holdout_rms / current_holdout_rms;
-  out.score.t_statistic = paired_t(current_residual, r, c.holdout, c.opt.significance_blocks);
+  out.score.t_statistic = paired_t(current_residual, r, held, c.opt.significance_blocks);
   out.score.significant =
       out.score.relative_drop >= c.opt.min_relative_drop && out.score.t_statistic >= c.opt.min_t_statistic;
   out.score.rejected_reason = physical_bounds_violation(c, out.spec, d, b, cand.name);

@@ -41,7 +41,7 @@ void choose_curve(const Context& c, Spec& spec) {
     t.knots = knots_for(nk);
     t.delta_max = choose_delta_max(c, t);
     const Design d = build(c, t);
-    const double r = rms_of(c.y - d.x * fit(c, d, c.train), c.holdout);
+    const double r = rms_of(c.y - d.x * fit(c, d, c.train), fit_rows(d, c.holdout));
     scores.emplace_back(t, r);
   }
   double best = std::numeric_limits<double>::infinity();

@@ -274,7 +274,7 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
     for (const auto& g : r.gross_outlier_samples) md << " " << g;
     md << ".\n";
   }
-  md << "\nThe fit, the RMS and max figures (not the held-out RMS) and the structure tests leave out the " << r.final_errors.unscored_initial_samples
+  md << "\nThe fit, every figure and the structure tests leave out the " << r.final_errors.unscored_initial_samples
      << " samples before the position had travelled 2 Delta_max from its running extreme (the "
         "friction's initial state is unknown until then; baseline: "
      << r.baseline.unscored_initial_samples << ").\n";

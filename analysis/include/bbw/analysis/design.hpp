@@ -75,7 +75,8 @@ std::vector<Vec> column_values(const Context& c, const ColumnEffect& e);
 // The position the model sees: delayed and/or through the play operator.
 Vec effective_position(const Context& c, const Spec& s);
 Design build(const Context& c, const Spec& s);
-// The rows of `rows` (ascending) the fit uses: those from d.first_known on, as the online
+// The rows of `rows` (ascending) the fit uses, and the held-out rows that are scored: those
+// from d.first_known on, as the online
 // calibrator starts no cycle before its element states are known; all of `rows` when fewer
 // than twice the model's columns would be left (a recording that never travels 2 Delta_max).
 std::vector<Index> fit_rows(const Design& d, const std::vector<Index>& rows);
