@@ -63,6 +63,12 @@ void AnalysisOptions::validate() const {
   }
   if (!(curve_knots_tolerance >= 0.0 && curve_knots_tolerance < 1.0))
     bad("curve_knots_tolerance", curve_knots_tolerance, "must be in [0, 1)");
+  if (friction_thresholds.size() > 64) bad("friction_thresholds", static_cast<double>(friction_thresholds.size()), "at most 64 elements");
+  for (std::size_t i = 0; i < friction_thresholds.size(); ++i) {
+    const double d = friction_thresholds[i];
+    if (!(d > 0.0) || !std::isfinite(d) || (i > 0 && !(d > friction_thresholds[i - 1])))
+      bad("friction_thresholds", d, "must be finite, > 0 and increasing");
+  }
   if (elements_M < 1 || elements_M > 64) bad("elements_M", elements_M, "must be in [1, 64]");
   if (!(geometric_ratio > 0.0 && geometric_ratio <= 1.0)) bad("geometric_ratio", geometric_ratio, "must be in (0, 1]");
   positive_grid("delta_max_fractions", delta_max_fractions, false);

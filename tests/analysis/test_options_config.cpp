@@ -72,3 +72,14 @@ TEST(AnalysisConfig, EffectsMapSwitchesCandidatesAndAttribution) {
   EXPECT_TRUE(o.is_sensor_effect("backlash"));
   EXPECT_TRUE(o.is_sensor_effect("viscous_friction"));
 }
+
+// bbw_analyze's friction: the shipped calibrator's element set for a position in rev, the
+// Delta_max grid (empty set) for another unit or --calibrator none.
+TEST(AnalysisConfig, FrictionFromTheCalibratorOnlyForAPositionInRev) {
+  const auto shipped = analyze::calibrator_friction_thresholds("", "rev");
+  EXPECT_FALSE(shipped.empty());
+  EXPECT_TRUE(analyze::calibrator_friction_thresholds("", "m").empty());
+  EXPECT_TRUE(analyze::calibrator_friction_thresholds("none", "rev").empty());
+  const std::string file = source_dir() + "/config/calibrator/robust.yaml";
+  EXPECT_EQ(analyze::calibrator_friction_thresholds(file, "m"), shipped);
+}

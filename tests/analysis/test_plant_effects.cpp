@@ -13,6 +13,7 @@
 #include <string>
 
 #include "bbw/analysis/analysis.hpp"
+#include "caliper_options.hpp"
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/calibration/offline.hpp"
 #include "bbw/scenario/corner_sim.hpp"
@@ -96,7 +97,7 @@ std::string describe(const analysis::AnalysisResult& r) {
 class PlantEffect : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(PlantEffect, NamedFirstAndWorstCaseErrorAtLeastHalves) {
-  const auto r = analysis::analyze(record({GetParam()}), analysis::AnalysisOptions{});
+  const auto r = analysis::analyze(record({GetParam()}), test::caliper_options());
   ASSERT_FALSE(r.steps.empty()) << describe(r);
   EXPECT_EQ(r.steps[0].evidence.name, analysis_name(GetParam())) << describe(r);
   ASSERT_TRUE(r.baseline.has_truth);
@@ -114,7 +115,7 @@ class OnlineTerm : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(OnlineTerm, WhatTheAnalysisFindsSwitchedOnInTheCalibratorHalvesItsError) {
   const analysis::Recording rec = record({GetParam() == "temperature_drift" ? "thermal_drift" : GetParam()});
-  const auto r = analysis::analyze(rec, analysis::AnalysisOptions{});
+  const auto r = analysis::analyze(rec, test::caliper_options());
   ASSERT_FALSE(r.steps.empty()) << describe(r);
   ASSERT_EQ(r.steps[0].evidence.name, GetParam()) << describe(r);
   const auto terms = analysis::calibrator_terms(r);
@@ -164,14 +165,14 @@ INSTANTIATE_TEST_SUITE_P(PaperRig, OnlineTerm,
                                            "temperature_drift"));
 
 TEST(PlantNoEffect, AddsNothingAndReportsNoStructure) {
-  const auto r = analysis::analyze(record({}), analysis::AnalysisOptions{});
+  const auto r = analysis::analyze(record({}), test::caliper_options());
   EXPECT_TRUE(r.steps.empty()) << describe(r);
   EXPECT_FALSE(r.unexplained_structure) << describe(r);
   EXPECT_TRUE(analysis::calibrator_terms(r).empty());
 }
 
 TEST(PlantTwoEffects, FindsBoth) {
-  const auto r = analysis::analyze(record({"viscous_friction", "creep"}), analysis::AnalysisOptions{});
+  const auto r = analysis::analyze(record({"viscous_friction", "creep"}), test::caliper_options());
   std::vector<std::string> n;
   for (const auto& s : r.steps) n.push_back(s.evidence.name);
   EXPECT_NE(std::find(n.begin(), n.end(), "viscous_friction"), n.end()) << describe(r);

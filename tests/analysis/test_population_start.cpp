@@ -9,6 +9,9 @@
 #include <cstdlib>
 
 #include "bbw/analysis/analysis.hpp"
+#include "caliper_options.hpp"
+#include "bbw/calibration/calibrator.hpp"
+#include "bbw/calibration/config_yaml.hpp"
 #include "bbw/calibration/maxwell_slip.hpp"
 #include "bbw/scenario/corner_sim.hpp"
 #include "bbw/scenario/load.hpp"
@@ -58,9 +61,9 @@ TEST(AnalyzePopulation, SaturatedInitialFrictionDoesNotDominateTheMaxFigures) {
   sc.corners.resize(1);  // 28 C
   sc.plant.key_friction.half_width_kN = 2.0;
   sc.plant.key_friction.initial_deflection = -1.0;  // the drive starts upwards: the worst start
-  const auto saturated = analysis::analyze(record(sc), analysis::AnalysisOptions{});
+  const auto saturated = analysis::analyze(record(sc), test::caliper_options());
   sc.plant.key_friction.initial_deflection = 0.0;
-  const auto relaxed = analysis::analyze(record(sc), analysis::AnalysisOptions{});
+  const auto relaxed = analysis::analyze(record(sc), test::caliper_options());
   std::printf("unscored %zu samples; max error vs truth saturated %.3f, relaxed %.3f kN; RMS %.3f / %.3f kN\n",
               saturated.baseline.unscored_initial_samples, saturated.baseline.max_truth_error,
               relaxed.baseline.max_truth_error, saturated.baseline.rms_truth_error, relaxed.baseline.rms_truth_error);
@@ -85,10 +88,10 @@ TEST(AnalyzeOutliers, OneGrossPositionOutlierIsRejectedAndCreatesNoEffect) {
   auto rec = record(sc);
   // A recorded channel the analysis could blame for the spike, as in the issue's file.
   rec.channels.push_back({"command", rec.position});
-  const auto clean = analysis::analyze(rec, analysis::AnalysisOptions{});
+  const auto clean = analysis::analyze(rec, test::caliper_options());
   auto bad = rec;
   bad.position[12345] = 1e10;
-  const auto r = analysis::analyze(bad, analysis::AnalysisOptions{});
+  const auto r = analysis::analyze(bad, test::caliper_options());
   std::printf("clean: %zu steps, RMS residual %.4f kN; with the outlier: %zu steps, RMS residual %.4f kN, %zu outlier(s) %s\n",
               clean.steps.size(), clean.final_errors.rms_residual, r.steps.size(), r.final_errors.rms_residual,
               r.gross_outliers, r.gross_outlier_samples.empty() ? "" : r.gross_outlier_samples.front().c_str());
@@ -125,7 +128,7 @@ TEST(AnalyzeBounds, UnphysicalCreepIsRejectedWithItsReason) {
     rec.position.push_back(s.position_rev);
     rec.force.push_back(s.force_internal_kN - 2.0 * sim.plant().state().creep_kN);
   }
-  const auto r = analysis::analyze(rec, analysis::AnalysisOptions{});
+  const auto r = analysis::analyze(rec, test::caliper_options());
   for (const auto& st : r.steps) {
     EXPECT_NE(st.evidence.name, "creep") << "creep accepted with an unphysical fraction";
   }
@@ -176,8 +179,8 @@ const analysis::Step* drift_step(const analysis::AnalysisResult& r) {
 }  // namespace
 
 TEST(AnalyzeAmbiguity, OffsetVersusCurveShiftIsAmbiguousOnlyWhenThePadsNeverOpen) {
-  const auto open = analysis::analyze(thermal_rig(0.3), analysis::AnalysisOptions{});
-  const auto closed = analysis::analyze(thermal_rig(1.0), analysis::AnalysisOptions{});
+  const auto open = analysis::analyze(thermal_rig(0.3), test::caliper_options());
+  const auto closed = analysis::analyze(thermal_rig(1.0), test::caliper_options());
   const auto* so = drift_step(open);
   const auto* sc = drift_step(closed);
   ASSERT_NE(so, nullptr);
@@ -196,4 +199,25 @@ TEST(AnalyzeAmbiguity, OffsetVersusCurveShiftIsAmbiguousOnlyWhenThePadsNeverOpen
   for (const auto& t : analysis::calibrator_terms(closed)) closed_term = closed_term || t.key == "load_cell_offset_kN_per_C";
   EXPECT_TRUE(open_term);
   EXPECT_FALSE(closed_term);
+}
+
+// Issue 13 item 6: analyze's friction structure and the online calibrator's are the same
+// method in one place (calibration::friction_thresholds_rev): the calibrator runs that element
+// set and analyze fits it, with no Delta_max of its own.
+TEST(AnalyzeFriction, FitsTheOnlineCalibratorsElementSet) {
+  const auto cfg = calibration::load_config(source_dir() + "/config/calibrator/robust.yaml");
+  const auto set = calibration::friction_thresholds_rev(cfg);
+  ASSERT_EQ(set.size(), static_cast<std::size_t>(cfg.elements_M));
+  EXPECT_EQ(calibration::Calibrator(cfg).friction().delta_rev, set);
+  const auto opt = test::caliper_options();
+  EXPECT_EQ(opt.friction_thresholds, set);
+  const auto spec = scenario::load_population_spec(source_dir() + "/config/population/scoring.yaml");
+  auto sc = scenario::population_scenario(spec, 0);
+  sc.corners.resize(1);
+  const auto r = analysis::analyze(record(sc), opt);
+  EXPECT_EQ(r.baseline_delta_max, cfg.delta_max_rev);
+  std::size_t k_params = 0;
+  for (const auto& p : r.final_parameters) k_params += p.name.rfind("K_", 0) == 0 ? 1 : 0;
+  EXPECT_EQ(k_params, set.size());
+  for (const auto& st : r.steps) EXPECT_EQ(st.delta_max, cfg.delta_max_rev);
 }

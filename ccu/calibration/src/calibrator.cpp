@@ -100,9 +100,7 @@ Calibrator::Calibrator(const CalibratorConfig& config)
       solver_(kCurveTerms + config.elements_M + (config.viscous_friction ? 1 : 0)) {
   const auto m = static_cast<std::size_t>(m_);
   const auto p = static_cast<std::size_t>(p_);
-  friction_.delta_rev.assign(m, 0.0);
-  const bool geometric = robust_ && config.spacing == ThresholdSpacing::Geometric;
-  thresholds(m, config.delta_max_rev, geometric, config.geometric_ratio, friction_.delta_rev.data());
+  friction_.delta_rev = friction_thresholds_rev(config);
   friction_.stiffness_kN_per_rev.assign(m, 0.0);
   phi_kN_.assign(m + static_cast<std::size_t>(e_), 0.0);
   identified_.assign(m + static_cast<std::size_t>(e_), 0);

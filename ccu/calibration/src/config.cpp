@@ -4,6 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "bbw/calibration/maxwell_slip.hpp"
+
 namespace bbw::calibration {
 
 namespace {
@@ -17,6 +19,14 @@ namespace {
 }  // namespace
 
 const char* to_string(Mode m) { return m == Mode::Paper ? "paper" : "robust"; }
+
+std::vector<double> friction_thresholds_rev(const CalibratorConfig& config) {
+  const auto m = static_cast<std::size_t>(config.elements_M > 0 ? config.elements_M : 0);
+  std::vector<double> out(m, 0.0);
+  const bool geometric = config.mode == Mode::Robust && config.spacing == ThresholdSpacing::Geometric;
+  thresholds(m, config.delta_max_rev, geometric, config.geometric_ratio, out.data());
+  return out;
+}
 
 void CalibratorConfig::validate() const {
   if (elements_M < 1 || elements_M > 64) bad("elements_M", elements_M, "must be in [1, 64]");

@@ -12,12 +12,15 @@ std::string usage() {
   return "usage: bbw_analyze --input FILE.csv --out DIR [--config FILE.yaml]\n"
          "         [--time COL] [--position COL] [--force COL] [--truth COL|none]\n"
          "         [--temperature COL|none] [--velocity COL] [--acceleration COL]\n"
-         "         [--channels A,B,...|none] [--allow-unsorted-time]\n"
+         "         [--channels A,B,...|none] [--allow-unsorted-time] [--calibrator FILE.yaml|none]\n"
          "defaults: time_s (or t_s), position_rev, force_internal_kN, truth force_external_kN and\n"
          "temperature temperature_C and velocity speed_rev_s when present; channels: every other\n"
          "column of the header except those whose name contains 'true' (simulator ground truth).\n"
          "Time must increase strictly; --allow-unsorted-time drops the lines where it does not\n"
-         "and counts them.\n";
+         "and counts them.\n"
+         "Friction: the online calibrator's element set (its config, default the shipped\n"
+         "config/calibrator/robust.yaml) when the position is in rev or --calibrator is given;\n"
+         "else, or with --calibrator none, Delta_max chosen on a grid of the position range.\n";
 }
 
 namespace {
@@ -48,6 +51,7 @@ CliArgs parse_args(const std::vector<std::string>& args) {
     if (k == "--input") a.input = next();
     else if (k == "--out") a.out = next();
     else if (k == "--config") a.config = next();
+    else if (k == "--calibrator") a.calibrator = next();
     else if (k == "--time") a.time_col = next();
     else if (k == "--position") a.position_col = next();
     else if (k == "--force") a.force_col = next();

@@ -1,5 +1,8 @@
 #include "bbw/analyze/config_loader.hpp"
 
+#include "bbw/calibration/config_yaml.hpp"
+#include "bbw/common/data_path.hpp"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -90,6 +93,13 @@ analysis::AnalysisOptions load_options(config::Reader& r) {
 analysis::AnalysisOptions load_options_file(const std::string& file) {
   auto r = config::Reader::from_file(file);
   return load_options(r);
+}
+
+std::vector<double> calibrator_friction_thresholds(const std::string& calibrator_file, const std::string& position_unit) {
+  if (calibrator_file == "none") return {};
+  if (calibrator_file.empty() && position_unit != "rev") return {};
+  const std::string file = calibrator_file.empty() ? data::path("config/calibrator/robust.yaml") : calibrator_file;
+  return calibration::friction_thresholds_rev(calibration::load_config(file));
 }
 
 }  // namespace bbw::analyze

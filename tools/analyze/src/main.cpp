@@ -25,8 +25,9 @@ int main(int argc, char** argv) {
   }
   // From here on an error is one line (file:line: reason), without the usage text.
   try {
-    const auto opts = cli.config.empty() ? analysis::AnalysisOptions{} : analyze::load_options_file(cli.config);
+    auto opts = cli.config.empty() ? analysis::AnalysisOptions{} : analyze::load_options_file(cli.config);
     const auto in = analyze::load_recording(cli);
+    opts.friction_thresholds = analyze::calibrator_friction_thresholds(cli.calibrator, in.position_unit);
     if (in.lines_rejected > 0 || in.lines_unsorted_time > 0) std::cerr << "bbw_analyze: " << in.file << ": " << in.rejection_summary << "\n";
     const auto t0 = std::chrono::steady_clock::now();
     const auto result = analysis::analyze(in.rec, opts);

@@ -88,9 +88,17 @@ std::string analysis_json(const LoadedRecording& in, const analysis::AnalysisOpt
   w.value("position_unit", in.position_unit);
   w.begin_object("method");
   w.value("model", "eq. 5: cubic in position scaled to [-1,1] + Maxwell-slip friction, geometric thresholds, K_i >= 0 (active-set NNLS), element states streamed over every sample");
-  w.value("elements_M", o.elements_M);
-  w.value("geometric_ratio", o.geometric_ratio);
-  w.value("delta_max_rule", "grid over fractions of the position range, minimum fit-part RMS; re-chosen after every step");
+  if (o.friction_thresholds.empty()) {
+    w.value("elements_M", o.elements_M);
+    w.value("geometric_ratio", o.geometric_ratio);
+    w.value("delta_max_rule", "grid over fractions of the position range, minimum fit-part RMS; re-chosen after every step");
+  } else {
+    w.value("elements_M", static_cast<int>(o.friction_thresholds.size()));
+    w.value("delta_max_rule", "the online calibrator's element set (calibration::friction_thresholds_rev of its config), fixed");
+    w.begin_array("friction_thresholds");
+    for (double d : o.friction_thresholds) w.value("", d);
+    w.end_array();
+  }
   w.value("differentiator", r.differentiator);
   w.value("holdout", o.split == analysis::HoldoutSplit::Interleaved ? "interleaved blocks" : "tail");
   w.value("holdout_fraction", o.holdout_fraction);
@@ -245,8 +253,10 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
   if (truth) md << ", truth `" << in.truth_col << "`";
   md << ". Held out: " << r.holdout_samples << " samples ("
      << (o.split == analysis::HoldoutSplit::Interleaved ? "interleaved blocks" : "tail") << ").\n\n";
-  md << "Baseline: eq. 5 with " << (r.curve_knots == 0 ? std::string("a cubic curve") : "a cubic-spline curve with " + std::to_string(r.curve_knots) + " interior knots") << ", M = " << o.elements_M << " geometric elements, Delta_max = " << fmt(r.baseline_delta_max)
-     << " (chosen by fit-part RMS). " << r.differentiator << ".\n\n";
+  md << "Baseline: eq. 5 with " << (r.curve_knots == 0 ? std::string("a cubic curve") : "a cubic-spline curve with " + std::to_string(r.curve_knots) + " interior knots") << ", M = "
+     << (o.friction_thresholds.empty() ? o.elements_M : static_cast<int>(o.friction_thresholds.size()))
+     << " geometric elements, Delta_max = " << fmt(r.baseline_delta_max)
+     << (o.friction_thresholds.empty() ? " (chosen by fit-part RMS). " : " (the online calibrator's element set). ") << r.differentiator << ".\n\n";
   md << "| | RMS residual | max residual | held-out RMS |" << (truth ? " RMS error vs truth | max error vs truth |" : "")
      << "\n|---|---|---|---|" << (truth ? "---|---|" : "") << "\n";
   auto row = [&](const std::string& name, const analysis::ErrorFigures& e) {
@@ -264,7 +274,7 @@ void write_outputs(const std::string& dir, const LoadedRecording& in, const anal
     for (const auto& g : r.gross_outlier_samples) md << " " << g;
     md << ".\n";
   }
-  md << "\nMax figures leave out the " << r.final_errors.unscored_initial_samples
+  md << "\nThe fit, every figure and the structure tests leave out the " << r.final_errors.unscored_initial_samples
      << " samples before the position had travelled 2 Delta_max from its running extreme (the "
         "friction's initial state is unknown until then; baseline: "
      << r.baseline.unscored_initial_samples << ").\n";

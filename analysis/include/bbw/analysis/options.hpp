@@ -36,6 +36,13 @@ struct AnalysisOptions {
   // the fewest knots whose held-out RMS is within curve_knots_tolerance of the best.
   std::vector<int> curve_knots_grid = {0, 1, 2, 3, 4, 6, 8};
   double curve_knots_tolerance = 0.02;
+  // The friction's element thresholds (position units, smallest first). Non-empty: the model's
+  // friction is exactly this element set, the online calibrator's
+  // (calibration::friction_thresholds_rev of its config; bbw_analyze fills it for a recording
+  // whose position is in rev), and no Delta_max is searched. Empty (a recording in another
+  // unit, where the product's element set means nothing): elements_M geometric elements with
+  // Delta_max chosen on delta_max_fractions of the position range by fit-part RMS.
+  std::vector<double> friction_thresholds;
   int elements_M = 8;
   double geometric_ratio = 0.6;  // Delta_{i-1} = ratio * Delta_i, Delta_M = Delta_max
   // Delta_max grid, as fractions of the position range; chosen by fit-part RMS.

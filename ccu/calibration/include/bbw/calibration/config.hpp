@@ -5,6 +5,7 @@
 #include <cstddef>
 
 #include <string>
+#include <vector>
 
 #include "bbw/calibration/curve.hpp"
 
@@ -104,5 +105,11 @@ struct CalibratorConfig {
 };
 
 const char* to_string(Mode m);
+
+// The friction's element thresholds Delta_i (rev, smallest first) of a calibrator with this
+// config: geometric from delta_max_rev down (robust mode, geometric spacing) or even. The one
+// place the friction's structure is computed: the online calibrator runs it and ./bbw analyze
+// fits it (issue 13: the same method in one place).
+std::vector<double> friction_thresholds_rev(const CalibratorConfig& config);
 
 }  // namespace bbw::calibration

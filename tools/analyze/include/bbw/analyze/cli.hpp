@@ -11,6 +11,9 @@ namespace bbw::analyze {
 
 struct CliArgs {
   std::string input, out, config;
+  // The online calibrator's config whose friction element set the model fits; "" = the shipped
+  // config/calibrator/robust.yaml when the position is in rev, "none" = Delta_max on a grid.
+  std::string calibrator;
   std::string time_col, position_col, force_col, truth_col, temperature_col, velocity_col, acceleration_col;
   bool channels_given = false;
   std::vector<std::string> channels;  // "--channels none" gives an empty list

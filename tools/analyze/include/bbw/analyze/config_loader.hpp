@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "bbw/analysis/options.hpp"
 #include "bbw/common/strict_yaml.hpp"
@@ -12,5 +13,12 @@ namespace bbw::analyze {
 
 analysis::AnalysisOptions load_options(config::Reader& r);
 analysis::AnalysisOptions load_options_file(const std::string& file);
+
+// The friction structure of the online calibrator, from the one place it is computed
+// (calibration::friction_thresholds_rev): the thresholds of `calibrator_file`'s config, or of the
+// shipped config/calibrator/robust.yaml when `calibrator_file` is empty and the position is in
+// rev. Empty (Delta_max searched on a grid) for "none" or a position in another unit, where the
+// product's element set in rev means nothing.
+std::vector<double> calibrator_friction_thresholds(const std::string& calibrator_file, const std::string& position_unit);
 
 }  // namespace bbw::analyze
