@@ -12,7 +12,8 @@
 #include "bbw/analysis/differentiate.hpp"
 #include "bbw/analysis/effects.hpp"
 #include "bbw/analysis/residual_tests.hpp"
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/maxwell_slip.hpp"
+#include "bbw/model/states_known.hpp"
 
 namespace bbw::analysis {
 

@@ -9,7 +9,7 @@
 #include <cstdlib>
 
 #include "bbw/analysis/analysis.hpp"
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/states_known.hpp"
 #include "bbw/scenario/corner_sim.hpp"
 #include "bbw/scenario/load.hpp"
 #include "bbw/scenario/population.hpp"

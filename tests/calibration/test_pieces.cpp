@@ -7,7 +7,7 @@
 
 #include "bbw/calibration/bounded_lsq.hpp"
 #include "bbw/calibration/cycle_detector.hpp"
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/maxwell_slip.hpp"
 #include "bbw/calibration/sample_store.hpp"
 
 using namespace bbw::calibration;

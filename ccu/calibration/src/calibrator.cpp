@@ -4,7 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/maxwell_slip.hpp"
+#include "bbw/model/play.hpp"
 
 namespace bbw::calibration {
 

@@ -10,11 +10,12 @@
 
 #include "bbw/calibration/bounded_lsq.hpp"
 #include "bbw/calibration/config.hpp"
-#include "bbw/common/delay_line.hpp"
-#include "bbw/calibration/curve.hpp"
-#include "bbw/calibration/maxwell_slip.hpp"
 #include "bbw/calibration/cycle_detector.hpp"
 #include "bbw/calibration/sample_store.hpp"
+#include "bbw/model/curve.hpp"
+#include "bbw/model/delay_line.hpp"
+#include "bbw/model/maxwell_slip.hpp"
+#include "bbw/model/states_known.hpp"
 
 namespace bbw::calibration {
 

@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "bbw/calibration/curve.hpp"
+#include "bbw/model/curve.hpp"
 
 namespace bbw::calibration {
 

@@ -9,8 +9,9 @@
 #include <cstddef>
 #include <vector>
 
-#include "bbw/calibration/curve.hpp"
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/curve.hpp"
+#include "bbw/model/maxwell_slip.hpp"
+#include "bbw/model/play.hpp"
 
 namespace bbw::calibration {
 

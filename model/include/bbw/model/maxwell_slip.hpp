@@ -24,15 +24,6 @@ inline double element_step(double x_rev, double delta_rev, double& pos_rev) {
   return d / delta_rev;
 }
 
-// Backlash: one step of the play operator. `spindle_rev` (the state) is dragged along so that it
-// stays within half the play of the resolver position; returns it.
-inline double play_step(double& spindle_rev, double x_rev, double width_rev) {
-  const double half = 0.5 * width_rev;
-  if (spindle_rev < x_rev - half) spindle_rev = x_rev - half;
-  if (spindle_rev > x_rev + half) spindle_rev = x_rev + half;
-  return spindle_rev;
-}
-
 // Load-dependent key friction: the factor 1 + g max(F, 0) / F_ref on the Maxwell-slip friction
 // at clamp force F (kN).
 inline double load_friction_scale(double gain, double reference_kN, double force_kN) {
@@ -55,44 +46,6 @@ inline double elements_step(double x_rev, const double* delta_rev, double* pos_r
     if (k_kN_per_rev) f += k_kN_per_rev[i] * delta_rev[i] * n;
   }
   return f;
-}
-
-// When the element states are known whatever the friction's initial deflection: once x has
-// moved 2 Delta_max from its running lowest or highest position, every element (the real
-// one and a model started relaxed alike) has been dragged to x -/+ Delta_i. Shared by the
-// online calibrator (cycle starts before it are ignored) and ./bbw analyze (samples before it
-// are not scored).
-class StatesKnown {
- public:
-  explicit StatesKnown(double delta_max) : two_delta_(2.0 * delta_max) {}
-  // Feeds one position; true from the sample at which the states are known on.
-  bool update(double x) {
-    if (known_) return true;
-    if (!started_) {
-      low_ = high_ = x;
-      started_ = true;
-    }
-    low_ = x < low_ ? x : low_;
-    high_ = x > high_ ? x : high_;
-    known_ = x - low_ >= two_delta_ || high_ - x >= two_delta_;
-    return known_;
-  }
-  bool known() const { return known_; }
-
- private:
-  double two_delta_;
-  double low_ = 0.0, high_ = 0.0;
-  bool started_ = false;
-  bool known_ = false;
-};
-
-// Index of the first sample at which the states are known (n when never).
-inline std::size_t first_known_sample(const double* x, std::size_t n, double delta_max) {
-  StatesKnown s(delta_max);
-  for (std::size_t k = 0; k < n; ++k) {
-    if (s.update(x[k])) return k;
-  }
-  return n;
 }
 
 // Thresholds: even Delta_i = (i / M) Delta_max, or geometric Delta_M = Delta_max,
