@@ -24,17 +24,6 @@ inline double element_step(double x_rev, double delta_rev, double& pos_rev) {
   return d / delta_rev;
 }
 
-// Load-dependent key friction: the factor 1 + g max(F, 0) / F_ref on the Maxwell-slip friction
-// at clamp force F (kN).
-inline double load_friction_scale(double gain, double reference_kN, double force_kN) {
-  return 1.0 + gain * (force_kN > 0.0 ? force_kN : 0.0) / reference_kN;
-}
-
-// Load-cell thermal offset k (T - T_ref), kN.
-inline double load_cell_offset_kN(double kN_per_C, double reference_C, double temperature_C) {
-  return kN_per_C * (temperature_C - reference_C);
-}
-
 // Steps all M elements at x; writes n_i into n_out (may be null). Returns sum K_i Delta_i n_i
 // when k is non-null, else 0.
 inline double elements_step(double x_rev, const double* delta_rev, double* pos_rev, std::size_t m,

@@ -100,7 +100,7 @@ class Calibrator {
   bool scaled_;
   bool nonneg_;
   int m_;      // elements
-  int e_;      // extra effect terms (0 or 1: viscous)
+  int e_;      // regressor columns of the effect terms (CalibratorConfig::effect_columns)
   int p_;      // parameters per fit: 4 + M + E
   double xc_rev_, xh_rev_;  // scaling x_s = (x - xc) / xh
 
