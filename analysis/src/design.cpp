@@ -6,7 +6,8 @@
 
 #include "bbw/analysis/bounded_lsq.hpp"
 #include "bbw/analysis/effects.hpp"
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/maxwell_slip.hpp"
+#include "bbw/model/states_known.hpp"
 
 namespace bbw::analysis::detail {
 

@@ -58,15 +58,16 @@ bool from_msg(const msg::CalibrationState& in, CalibrationModel& out) {
   for (std::size_t i = 0; i < d.size(); ++i) {
     if (!std::isfinite(d[i]) || !(d[i] > 0.0) || !std::isfinite(k[i])) return false;
   }
-  // The effect terms within the calibrator config's own bounds (config.cpp).
-  if (!(in.friction_viscous_kN_per_rev_per_s() >= 0.0 && std::isfinite(in.friction_viscous_kN_per_rev_per_s())) ||
-      !(in.friction_load_gain() >= 0.0 && in.friction_load_gain() <= 10.0) ||
-      !(in.friction_load_reference_kN() > 0.0 && std::isfinite(in.friction_load_reference_kN())) ||
-      !(in.backlash_width_rev() >= 0.0 && in.backlash_width_rev() <= 0.5) ||
-      !(in.load_cell_offset_kN_per_C() >= -1.0 && in.load_cell_offset_kN_per_C() <= 1.0) ||
-      !(in.load_cell_offset_reference_C() >= -50.0 && in.load_cell_offset_reference_C() <= 150.0)) {
-    return false;
-  }
+  // The effect terms within their own bounds (the term objects CalibratorConfig::validate checks
+  // through, bbw/model/effect_terms.hpp).
+  calibration::EffectTermValues terms;
+  terms.viscous_kN_per_rev_per_s = in.friction_viscous_kN_per_rev_per_s();
+  terms.load_friction_gain = in.friction_load_gain();
+  terms.load_friction_reference_kN = in.friction_load_reference_kN();
+  terms.backlash_width_rev = in.backlash_width_rev();
+  terms.load_cell_offset_kN_per_C = in.load_cell_offset_kN_per_C();
+  terms.load_cell_offset_reference_C = in.load_cell_offset_reference_C();
+  if (calibration::check_effect_terms(terms)) return false;
   out.curve = {in.curve_a_kN_per_rev3(), in.curve_b_kN_per_rev2(), in.curve_c_kN_per_rev(), in.curve_d_kN()};
   auto& f = out.friction;
   f.delta_rev.assign(d.begin(), d.end());

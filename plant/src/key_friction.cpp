@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/maxwell_slip.hpp"
 
 namespace bbw::plant {
 

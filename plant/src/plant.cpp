@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "bbw/model/play.hpp"
+
 namespace bbw::plant {
 namespace {
 
@@ -86,8 +88,7 @@ void Plant::substep(double i_cmd_A, double torque_scale, bool seized, double h_s
   const double x_prev = s_.position_rev;
   if (e_.backlash.enabled) {
     // Play operator: the spindle stays put (held by its own friction) inside the gap.
-    s_.position_rev = std::clamp(s_.position_rev, s_.motor_position_rev - half_play,
-                                 s_.motor_position_rev + half_play);
+    calibration::play_step(s_.position_rev, s_.motor_position_rev, e_.backlash.width_rev);
   } else {
     s_.position_rev = s_.motor_position_rev;
   }

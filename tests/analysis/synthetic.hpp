@@ -11,7 +11,7 @@
 
 #include "bbw/analysis/analysis.hpp"
 #include "bbw/analysis/effects.hpp"
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/maxwell_slip.hpp"
 
 namespace bbw::analysis::test {
 

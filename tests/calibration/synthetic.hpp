@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "bbw/calibration/config.hpp"
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/maxwell_slip.hpp"
 #include "bbw/calibration/offline.hpp"
 
 namespace bbw::calibration::test {

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "bbw/calibration/calibrator.hpp"
-#include "bbw/calibration/friction_tracker.hpp"
+#include "bbw/model/friction_tracker.hpp"
 #include "bbw/calibration/offline.hpp"
 #include "synthetic.hpp"
 

@@ -5,10 +5,15 @@
 #include <random>
 #include <vector>
 
+#include <stdexcept>
+#include <string>
+
 #include "bbw/calibration/bounded_lsq.hpp"
+#include "bbw/calibration/config.hpp"
 #include "bbw/calibration/cycle_detector.hpp"
-#include "bbw/calibration/maxwell_slip.hpp"
 #include "bbw/calibration/sample_store.hpp"
+#include "bbw/model/effect_terms.hpp"
+#include "bbw/model/maxwell_slip.hpp"
 
 using namespace bbw::calibration;
 
@@ -201,4 +206,48 @@ TEST(BoundedLeastSquares, NonNegativeMatchesBruteForce) {
     EXPECT_GE(t[3], 0.0);
     EXPECT_NEAR(cost(t), best, 1e-9 * std::max(1.0, best));
   }
+}
+
+// The effect terms' bounds are one copy: validate() names the term bound a value breaks (the same
+// bounds the YAML loader and the wire codec check through).
+TEST(EffectTerms, ValidateNamesTheTermBoundItBreaks) {
+  struct Case {
+    void (*spoil)(CalibratorConfig&);
+    const char* key;
+    const char* rule;
+  };
+  for (const Case& k : {Case{[](CalibratorConfig& c) { c.backlash_width_rev = 0.6; }, "backlash_width_rev", "must be in [0, 0.5]"},
+                        Case{[](CalibratorConfig& c) { c.force_delay_s = -0.001; }, "force_delay_s", "must be in [0, 0.05]"},
+                        Case{[](CalibratorConfig& c) { c.load_friction_gain = 11.0; }, "load_friction_gain", "must be in [0, 10]"},
+                        Case{[](CalibratorConfig& c) { c.load_friction_reference_kN = 0.0; }, "load_friction_reference_kN", "must be > 0"},
+                        Case{[](CalibratorConfig& c) { c.viscous_speed_scale_rev_per_s = 0.0; }, "viscous_speed_scale_rev_per_s", "must be > 0"},
+                        Case{[](CalibratorConfig& c) { c.load_cell_offset_kN_per_C = 1.5; }, "load_cell_offset_kN_per_C", "must be in [-1, 1]"},
+                        Case{[](CalibratorConfig& c) { c.load_cell_offset_reference_C = 200.0; }, "load_cell_offset_reference_C", "must be in [-50, 150]"}}) {
+    CalibratorConfig c;
+    k.spoil(c);
+    try {
+      c.validate();
+      ADD_FAILURE() << k.key << " accepted";
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(k.key), std::string::npos) << what;
+      EXPECT_NE(what.find(k.rule), std::string::npos) << what;
+    }
+  }
+  EXPECT_NO_THROW(CalibratorConfig{}.validate());
+}
+
+// Only the viscous term adds a regressor column; the others act on the position, the element
+// regressors or the reading.
+TEST(EffectTerms, OnlyTheViscousTermAddsAColumn) {
+  CalibratorConfig c;
+  EXPECT_EQ(c.effect_columns(), 0);
+  c.force_delay_s = 0.005;
+  c.backlash_width_rev = 0.05;
+  c.load_friction_gain = 0.9;
+  c.load_cell_offset_kN_per_C = 0.02;
+  EXPECT_EQ(c.effect_columns(), 0);
+  c.viscous_friction = true;
+  EXPECT_EQ(c.effect_columns(), 1);
+  EXPECT_EQ(std::tuple_size_v<EffectTerms>, 5u);
 }

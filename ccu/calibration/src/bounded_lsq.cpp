@@ -1,6 +1,7 @@
 #include "bbw/calibration/bounded_lsq.hpp"
 
 #include <cmath>
+#include <cstddef>
 #include <stdexcept>
 
 namespace bbw::calibration {
@@ -8,7 +9,7 @@ namespace bbw::calibration {
 BoundedLeastSquares::BoundedLeastSquares(int max_params) : max_(max_params) {
   if (max_params < 1) throw std::invalid_argument("BoundedLeastSquares: max_params must be >= 1");
   const auto m = static_cast<std::size_t>(max_params);
-  l_.assign(m * m, 0.0);
+  l_.assign(m * (m + 1) / 2, 0.0);  // packed lower triangle
   rhs_.assign(m, 0.0);
   idx_.assign(m, 0);
   passive_.assign(m, 0);
@@ -29,28 +30,33 @@ bool BoundedLeastSquares::solve_subset(const double* G, const double* h, int n, 
     z[j] = 0.0;
   }
   if (p == 0) return true;
-  // Cholesky: L L' = G_PP (lower triangle in l_, row-major p x p).
+  // Cholesky: L L' = G_PP, the lower triangle packed by rows in l_ (row r starts at r (r + 1) / 2).
+  double* l = l_.data();
+  auto row = [l](int r) { return l + static_cast<std::ptrdiff_t>(r) * (r + 1) / 2; };
   for (int r = 0; r < p; ++r) {
+    double* lr = row(r);
     for (int c = 0; c <= r; ++c) {
+      const double* lc = row(c);
       double s = G[idx_[static_cast<std::size_t>(r)] * n + idx_[static_cast<std::size_t>(c)]];
-      for (int k = 0; k < c; ++k) s -= l_[static_cast<std::size_t>(r * p + k)] * l_[static_cast<std::size_t>(c * p + k)];
+      for (int k = 0; k < c; ++k) s -= lr[k] * lc[k];
       if (r == c) {
         if (!(s > 0.0) || !std::isfinite(s)) return false;
-        l_[static_cast<std::size_t>(r * p + r)] = std::sqrt(s);
+        lr[r] = std::sqrt(s);
       } else {
-        l_[static_cast<std::size_t>(r * p + c)] = s / l_[static_cast<std::size_t>(c * p + c)];
+        lr[c] = s / lc[c];
       }
     }
   }
   for (int r = 0; r < p; ++r) {
+    const double* lr = row(r);
     double s = h[idx_[static_cast<std::size_t>(r)]];
-    for (int k = 0; k < r; ++k) s -= l_[static_cast<std::size_t>(r * p + k)] * rhs_[static_cast<std::size_t>(k)];
-    rhs_[static_cast<std::size_t>(r)] = s / l_[static_cast<std::size_t>(r * p + r)];
+    for (int k = 0; k < r; ++k) s -= lr[k] * rhs_[static_cast<std::size_t>(k)];
+    rhs_[static_cast<std::size_t>(r)] = s / lr[r];
   }
   for (int r = p - 1; r >= 0; --r) {
     double s = rhs_[static_cast<std::size_t>(r)];
-    for (int k = r + 1; k < p; ++k) s -= l_[static_cast<std::size_t>(k * p + r)] * rhs_[static_cast<std::size_t>(k)];
-    rhs_[static_cast<std::size_t>(r)] = s / l_[static_cast<std::size_t>(r * p + r)];
+    for (int k = r + 1; k < p; ++k) s -= row(k)[r] * rhs_[static_cast<std::size_t>(k)];
+    rhs_[static_cast<std::size_t>(r)] = s / row(r)[r];
   }
   for (int r = 0; r < p; ++r) z[idx_[static_cast<std::size_t>(r)]] = rhs_[static_cast<std::size_t>(r)];
   return true;

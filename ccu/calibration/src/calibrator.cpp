@@ -4,7 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/effect_terms.hpp"
+#include "bbw/model/maxwell_slip.hpp"
 
 namespace bbw::calibration {
 
@@ -87,17 +88,17 @@ Calibrator::Calibrator(const CalibratorConfig& config)
       scaled_(robust_ && config.scale_x),
       nonneg_(robust_ && config.nonnegative_k),
       m_(config.elements_M),
-      e_(config.viscous_friction ? 1 : 0),
-      p_(kCurveTerms + config.elements_M + (config.viscous_friction ? 1 : 0)),
+      e_(config.effect_columns()),
+      p_(kCurveTerms + config.elements_M + e_),
       xc_rev_(0.5 * (config.x_max_rev + config.x_min_rev)),
       xh_rev_(0.5 * (config.x_max_rev - config.x_min_rev)),
       curve_(config.initial_curve),
       detector_(config.start_lag_n0, robust_ ? config.start_margin_rev : 0.0),
-      store_(config.samples_L, config.elements_M + (config.viscous_friction ? 1 : 0), config.x_max_rev - config.x_min_rev,
+      store_(config.samples_L, config.elements_M + e_, config.x_max_rev - config.x_min_rev,
              config.f_max_kN - config.f_min_kN, config.drop_rule),
       states_known_rule_(config.delta_max_rev),
       position_delay_(CalibratorConfig::force_delay_slots(config.force_delay_s)),
-      solver_(kCurveTerms + config.elements_M + (config.viscous_friction ? 1 : 0)) {
+      solver_(p_) {
   const auto m = static_cast<std::size_t>(m_);
   const auto p = static_cast<std::size_t>(p_);
   friction_.delta_rev = friction_thresholds_rev(config);
@@ -341,8 +342,8 @@ void Calibrator::refit_curve_from_pf() {
 }
 
 double Calibrator::load_scale(double x_rev) const {
-  if (config_.load_friction_gain <= 0.0) return 1.0;
-  return load_friction_scale(config_.load_friction_gain, config_.load_friction_reference_kN, curve_.force_kN(x_rev));
+  if (!LoadFrictionTerm::on(config_.load_friction_gain)) return 1.0;
+  return LoadFrictionTerm::scale(config_.load_friction_gain, config_.load_friction_reference_kN, curve_.force_kN(x_rev));
 }
 
 // Resolver speed when the sample carries one; else the least-squares slope of the last
@@ -388,24 +389,25 @@ Estimate Calibrator::update(const Sample& s) {
   }
   // The load cell's thermal offset removed first: the model never sees it.
   double f_c = s.force_kN;
-  if (config_.load_cell_offset_kN_per_C != 0.0) {
+  if (LoadCellOffsetTerm::on(config_.load_cell_offset_kN_per_C)) {
     if (std::isfinite(s.temperature_C)) temperature_C_ = s.temperature_C;
-    f_c -= load_cell_offset_kN(config_.load_cell_offset_kN_per_C, config_.load_cell_offset_reference_C, temperature_C_);
+    f_c -= LoadCellOffsetTerm::offset_kN(config_.load_cell_offset_kN_per_C, config_.load_cell_offset_reference_C,
+                                         temperature_C_);
   }
   // With a force delay d the load cell at t belongs to the position at t - d: the model runs
   // on that position and the estimate is carried to the present along the curve.
-  const bool delayed = config_.force_delay_s > 0.0;
+  const bool delayed = ForceDelayTerm::on(config_.force_delay_s);
   if (delayed) position_delay_.push(s.time_s, s.position_rev);
   double x = delayed ? position_delay_.read(s.time_s - config_.force_delay_s) : s.position_rev;
   // The position the clamp force belongs to now (the curve estimate's argument).
   double x_now = s.position_rev;
-  if (config_.backlash_width_rev > 0.0) {
+  if (BacklashTerm::on(config_.backlash_width_rev)) {
     // The model runs on the spindle position; with a delay too, the play acts on the delayed
     // position and the present spindle is the play state pulled along to the present position.
     if (!have_time_) spindle_rev_ = x;
-    x = play_step(spindle_rev_, x, config_.backlash_width_rev);
+    x = BacklashTerm::spindle_rev(spindle_rev_, x, config_.backlash_width_rev);
     double pulled = spindle_rev_;
-    x_now = delayed ? play_step(pulled, s.position_rev, config_.backlash_width_rev) : x;
+    x_now = delayed ? BacklashTerm::spindle_rev(pulled, s.position_rev, config_.backlash_width_rev) : x;
   }
   if (!have_time_) {
     for (auto& p : element_pos_rev_) p = x;
@@ -436,7 +438,7 @@ Estimate Calibrator::update(const Sample& s) {
   const double friction = elements_step(x, friction_.delta_rev.data(), element_pos_rev_.data(),
                                         static_cast<std::size_t>(m_), nullptr, n_now_.data());
   (void)friction;
-  if (config_.load_friction_gain > 0.0) {
+  if (LoadFrictionTerm::on(config_.load_friction_gain)) {
     const double scale = load_scale(x);
     for (int i = 0; i < m_; ++i) n_now_[static_cast<std::size_t>(i)] *= scale;
   }

@@ -4,7 +4,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/maxwell_slip.hpp"
 
 namespace bbw::calibration {
 
@@ -16,7 +16,31 @@ namespace {
   throw std::invalid_argument(os.str());
 }
 
+// A term bound as a rule: "must be in [0, 0.5]", "must be > 0", ...
+std::string rule_of(const TermBound& b) {
+  std::ostringstream os;
+  if (b.max == kNoUpperBound) {
+    os << "must be " << (b.min_open ? "> " : ">= ") << b.min;
+  } else {
+    os << "must be in " << (b.min_open ? "(" : "[") << b.min << ", " << b.max << "]";
+  }
+  return os.str();
+}
+
 }  // namespace
+
+EffectTermValues CalibratorConfig::effect_values() const {
+  EffectTermValues v;
+  v.viscous = viscous_friction;
+  v.viscous_speed_scale_rev_per_s = viscous_speed_scale_rev_per_s;
+  v.force_delay_s = force_delay_s;
+  v.backlash_width_rev = backlash_width_rev;
+  v.load_friction_gain = load_friction_gain;
+  v.load_friction_reference_kN = load_friction_reference_kN;
+  v.load_cell_offset_kN_per_C = load_cell_offset_kN_per_C;
+  v.load_cell_offset_reference_C = load_cell_offset_reference_C;
+  return v;
+}
 
 const char* to_string(Mode m) { return m == Mode::Paper ? "paper" : "robust"; }
 
@@ -52,14 +76,8 @@ void CalibratorConfig::validate() const {
   if (!(ridge >= 0.0)) bad("ridge", ridge, "must be >= 0");
   if (!(max_fit_rms_kN > 0.0)) bad("max_fit_rms_kN", max_fit_rms_kN, "must be > 0");
   if (!(start_margin_rev >= 0.0)) bad("start_margin_rev", start_margin_rev, "must be >= 0");
-  if (!(viscous_speed_scale_rev_per_s > 0.0)) bad("viscous_speed_scale_rev_per_s", viscous_speed_scale_rev_per_s, "must be > 0");
   if (velocity_window < 2 || velocity_window > 1000) bad("velocity_window", velocity_window, "must be in [2, 1000]");
-  if (!(force_delay_s >= 0.0 && force_delay_s <= 0.05)) bad("force_delay_s", force_delay_s, "must be in [0, 0.05]");
-  if (!(load_friction_gain >= 0.0 && load_friction_gain <= 10.0)) bad("load_friction_gain", load_friction_gain, "must be in [0, 10]");
-  if (!(load_friction_reference_kN > 0.0)) bad("load_friction_reference_kN", load_friction_reference_kN, "must be > 0");
-  if (!(backlash_width_rev >= 0.0 && backlash_width_rev <= 0.5)) bad("backlash_width_rev", backlash_width_rev, "must be in [0, 0.5]");
-  if (!(load_cell_offset_kN_per_C >= -1.0 && load_cell_offset_kN_per_C <= 1.0)) bad("load_cell_offset_kN_per_C", load_cell_offset_kN_per_C, "must be in [-1, 1]");
-  if (!(load_cell_offset_reference_C >= -50.0 && load_cell_offset_reference_C <= 150.0)) bad("load_cell_offset_reference_C", load_cell_offset_reference_C, "must be in [-50, 150]");
+  if (const auto e = check_effect_terms(effect_values())) bad(e.bound->key, e.value, rule_of(*e.bound).c_str());
   if (!(k_smoothing > 0.0 && k_smoothing <= 1.0)) bad("k_smoothing", k_smoothing, "must be in (0, 1]");
   if (residual_window < 1 || residual_window > kMaxResidualWindow) {
     bad("residual_window", residual_window, "must be in [1, 64]");

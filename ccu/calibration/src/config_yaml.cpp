@@ -63,19 +63,19 @@ CalibratorConfig read_config(Reader& r) {
     rb->finish();
   }
   if (auto fx = r.optional_map("effects")) {
-    c.viscous_friction = fx->boolean_or("viscous_friction", c.viscous_friction);
-    c.viscous_speed_scale_rev_per_s =
-        fx->number_or("viscous_speed_scale_rev_per_s", c.viscous_speed_scale_rev_per_s, Range::positive());
+    c.viscous_friction = fx->boolean_or(ViscousTerm::key, c.viscous_friction);
+    // Bounds from the term objects (bbw/model/effect_terms.hpp), the one copy.
+    auto number = [&fx](const TermBound& b, double fallback) {
+      return fx->number_or(b.key, fallback, Range{b.min, b.max, b.min_open, false});
+    };
+    c.viscous_speed_scale_rev_per_s = number(ViscousTerm::speed_scale, c.viscous_speed_scale_rev_per_s);
     c.velocity_window = static_cast<int>(fx->integer_or("velocity_window", c.velocity_window, 2, 1000));
-    c.force_delay_s = fx->number_or("force_delay_s", c.force_delay_s, Range::closed(0.0, 0.05));
-    c.load_friction_gain = fx->number_or("load_friction_gain", c.load_friction_gain, Range::closed(0.0, 10.0));
-    c.load_friction_reference_kN =
-        fx->number_or("load_friction_reference_kN", c.load_friction_reference_kN, Range::positive());
-    c.backlash_width_rev = fx->number_or("backlash_width_rev", c.backlash_width_rev, Range::closed(0.0, 0.5));
-    c.load_cell_offset_kN_per_C =
-        fx->number_or("load_cell_offset_kN_per_C", c.load_cell_offset_kN_per_C, Range::closed(-1.0, 1.0));
-    c.load_cell_offset_reference_C =
-        fx->number_or("load_cell_offset_reference_C", c.load_cell_offset_reference_C, Range::closed(-50.0, 150.0));
+    c.force_delay_s = number(ForceDelayTerm::delay, c.force_delay_s);
+    c.load_friction_gain = number(LoadFrictionTerm::gain, c.load_friction_gain);
+    c.load_friction_reference_kN = number(LoadFrictionTerm::reference, c.load_friction_reference_kN);
+    c.backlash_width_rev = number(BacklashTerm::width, c.backlash_width_rev);
+    c.load_cell_offset_kN_per_C = number(LoadCellOffsetTerm::slope, c.load_cell_offset_kN_per_C);
+    c.load_cell_offset_reference_C = number(LoadCellOffsetTerm::reference, c.load_cell_offset_reference_C);
     fx->finish();
   }
   try {

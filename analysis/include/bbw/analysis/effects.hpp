@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/maxwell_slip.hpp"
 
 namespace bbw::analysis {
 

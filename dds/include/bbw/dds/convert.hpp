@@ -5,7 +5,7 @@
 #include <bbw/idl/bbw_msgs.h>
 
 #include "bbw/calibration/calibrator.hpp"
-#include "bbw/calibration/friction_tracker.hpp"
+#include "bbw/model/friction_tracker.hpp"
 #include "bbw/scenario/corner_sim.hpp"
 
 namespace bbw::dds {

@@ -10,7 +10,7 @@
 #include <random>
 
 #include "bbw/plant/clamp_curve.hpp"
-#include "bbw/common/delay_line.hpp"
+#include "bbw/model/delay_line.hpp"
 #include "bbw/plant/key_friction.hpp"
 #include "bbw/plant/params.hpp"
 

@@ -26,7 +26,7 @@ class BoundedLeastSquares {
   bool solve_subset(const double* G, const double* h, int n, double* z);  // on passive_
 
   int max_;
-  std::vector<double> l_;       // Cholesky factor workspace
+  std::vector<double> l_;       // Cholesky factor workspace, lower triangle packed by rows
   std::vector<double> rhs_;
   std::vector<int> idx_;        // indices of passive (free) variables
   std::vector<char> passive_;

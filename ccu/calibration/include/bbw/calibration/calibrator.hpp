@@ -10,11 +10,12 @@
 
 #include "bbw/calibration/bounded_lsq.hpp"
 #include "bbw/calibration/config.hpp"
-#include "bbw/common/delay_line.hpp"
-#include "bbw/calibration/curve.hpp"
-#include "bbw/calibration/maxwell_slip.hpp"
 #include "bbw/calibration/cycle_detector.hpp"
 #include "bbw/calibration/sample_store.hpp"
+#include "bbw/model/curve.hpp"
+#include "bbw/model/delay_line.hpp"
+#include "bbw/model/maxwell_slip.hpp"
+#include "bbw/model/states_known.hpp"
 
 namespace bbw::calibration {
 
@@ -99,7 +100,7 @@ class Calibrator {
   bool scaled_;
   bool nonneg_;
   int m_;      // elements
-  int e_;      // extra effect terms (0 or 1: viscous)
+  int e_;      // regressor columns of the effect terms (CalibratorConfig::effect_columns)
   int p_;      // parameters per fit: 4 + M + E
   double xc_rev_, xh_rev_;  // scaling x_s = (x - xc) / xh
 

@@ -7,7 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "bbw/calibration/curve.hpp"
+#include "bbw/model/curve.hpp"
+#include "bbw/model/effect_terms.hpp"
 
 namespace bbw::calibration {
 
@@ -60,7 +61,8 @@ struct CalibratorConfig {
   int residual_window = 1;
   static constexpr int kMaxResidualWindow = 64;
 
-  // Optional model terms for effects found offline (./bbw analyze), per caliper.
+  // Optional model terms for effects found offline (./bbw analyze), per caliper: the objects of
+  // bbw/model/effect_terms.hpp (EffectTerms) hold their bounds, columns and arithmetic.
   // viscous_friction: a load-cell term c_v * v (v = resolver speed, or the slope of the last
   // velocity_window positions when the sample carries no speed), fitted with K_i, c_v >= 0.
   bool viscous_friction = false;
@@ -99,6 +101,11 @@ struct CalibratorConfig {
   // 0 = off; |k| at most 1.
   double load_cell_offset_kN_per_C = 0.0;
   double load_cell_offset_reference_C = 40.0;
+
+  // The effect terms' values (EffectTerms), as the calibrator is configured.
+  EffectTermValues effect_values() const;
+  // Regressor columns the effect terms add (effect_columns).
+  int effect_columns() const { return calibration::effect_columns(effect_values()); }
 
   // Throws std::invalid_argument naming the field, its value and the rule.
   void validate() const;

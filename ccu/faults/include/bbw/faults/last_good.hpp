@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "bbw/calibration/calibrator.hpp"
-#include "bbw/calibration/curve.hpp"
+#include "bbw/model/curve.hpp"
 
 namespace bbw::faults {
 

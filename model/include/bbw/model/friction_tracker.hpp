@@ -1,16 +1,18 @@
 // The calibrator's friction model replayed elsewhere (a corner's friction-compensated load-cell
 // feedback, docs/distributed.md): Maxwell-slip elements with the published thresholds and
-// stiffnesses, plus the optional effect terms (backlash play, load-dependent scaling along the
-// published curve, viscous term), with its own element and play states. The same arithmetic as
-// Calibrator::update's friction estimate (tested against it). Allocates only in reset().
+// stiffnesses, plus the optional effect terms (effect_terms.hpp: backlash play, load-dependent
+// scaling along the published curve, viscous term, thermal offset), with its own element and play
+// states. The same arithmetic as Calibrator::update's friction estimate (tested against it).
+// Allocates only in reset().
 #pragma once
 
 #include <cmath>
 #include <cstddef>
 #include <vector>
 
-#include "bbw/calibration/curve.hpp"
-#include "bbw/calibration/maxwell_slip.hpp"
+#include "bbw/model/curve.hpp"
+#include "bbw/model/effect_terms.hpp"
+#include "bbw/model/maxwell_slip.hpp"
 
 namespace bbw::calibration {
 
@@ -38,13 +40,15 @@ class FrictionTracker {
   // Friction (kN) the load cell holds at resolver position x and speed v; the model's sizes
   // must match reset()'s.
   double step(const FrictionModel& m, double x_rev, double speed_rev_s) {
-    const double x = m.backlash_width_rev > 0.0 ? play_step(spindle_rev_, x_rev, m.backlash_width_rev) : x_rev;
+    const double x = BacklashTerm::on(m.backlash_width_rev)
+                         ? BacklashTerm::spindle_rev(spindle_rev_, x_rev, m.backlash_width_rev)
+                         : x_rev;
     double f = elements_step(x, m.delta_rev.data(), pos_rev_.data(), pos_rev_.size(), m.stiffness_kN_per_rev.data(),
                              nullptr);
-    if (m.load_gain > 0.0) {
-      f *= load_friction_scale(m.load_gain, m.load_reference_kN, m.curve.force_kN(x));
+    if (LoadFrictionTerm::on(m.load_gain)) {
+      f *= LoadFrictionTerm::scale(m.load_gain, m.load_reference_kN, m.curve.force_kN(x));
     }
-    return f + m.viscous_kN_per_rev_per_s * speed_rev_s;
+    return f + ViscousTerm::friction_kN(m.viscous_kN_per_rev_per_s, speed_rev_s);
   }
   // What the load cell reads beyond the clamp force at temperature T: the friction above plus
   // the thermal zero offset, as the calibrator removes it (a non-finite T: the last finite one;
@@ -55,8 +59,8 @@ class FrictionTracker {
       temperature_C_ = temperature_C;
       have_temperature_ = true;
     }
-    if (m.load_cell_offset_kN_per_C == 0.0 || !have_temperature_) return f;
-    return f + load_cell_offset_kN(m.load_cell_offset_kN_per_C, m.load_cell_offset_reference_C, temperature_C_);
+    if (!LoadCellOffsetTerm::on(m.load_cell_offset_kN_per_C) || !have_temperature_) return f;
+    return f + LoadCellOffsetTerm::offset_kN(m.load_cell_offset_kN_per_C, m.load_cell_offset_reference_C, temperature_C_);
   }
 
  private:
