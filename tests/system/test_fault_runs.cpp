@@ -48,37 +48,6 @@ LaunchRun launch(const std::string& scenario, const std::string& dir, int domain
   }
 }
 
-// A flat reading of summary.json's "faults" and "detections" arrays: one map per object, string
-// values unquoted. summary.json is written by our own writer, one key per line.
-std::vector<std::map<std::string, std::string>> objects(const std::string& json, const std::string& array) {
-  std::vector<std::map<std::string, std::string>> out;
-  const auto a = json.find("\"" + array + "\": [");
-  if (a == std::string::npos) return out;
-  const auto end = json.find(']', a);
-  std::size_t pos = a;
-  while (true) {
-    const auto open = json.find('{', pos);
-    if (open == std::string::npos || open > end) break;
-    const auto close = json.find('}', open);
-    std::map<std::string, std::string> m;
-    std::istringstream lines(json.substr(open + 1, close - open - 1));
-    std::string line;
-    while (std::getline(lines, line)) {
-      const auto q1 = line.find('"');
-      const auto q2 = line.find('"', q1 + 1);
-      const auto colon = line.find(':', q2);
-      if (q1 == std::string::npos || q2 == std::string::npos || colon == std::string::npos) continue;
-      std::string v = line.substr(colon + 1);
-      v.erase(0, v.find_first_not_of(' '));
-      while (!v.empty() && (v.back() == ',' || v.back() == ' ')) v.pop_back();
-      if (v.size() >= 2 && v.front() == '"') v = v.substr(1, v.size() - 2);
-      m[line.substr(q1 + 1, q2 - q1 - 1)] = v;
-    }
-    out.push_back(m);
-    pos = close + 1;
-  }
-  return out;
-}
 
 double num(const std::map<std::string, std::string>& m, const std::string& k) {
   const auto it = m.find(k);
