@@ -55,17 +55,17 @@ bool domain_port_in_use(int domain) {
 }
 
 DomainClaim claim_free_domain(std::uint64_t run_id) {
-  const int n = kAutoDomainLast - kAutoDomainFirst + 1;
+  const int n = kFreeDomainLast - kFreeDomainFirst + 1;
   const int offset = static_cast<int>(run_id % static_cast<std::uint64_t>(n));
   for (int i = 0; i < n; ++i) {
-    const int d = kAutoDomainFirst + (offset + i) % n;
+    const int d = kFreeDomainFirst + (offset + i) % n;
     auto claim = DomainClaim::try_claim(d);
     if (!claim) continue;
     if (domain_port_in_use(d)) continue;  // the claim is released when `claim` goes
     return std::move(*claim);
   }
-  throw std::runtime_error("no free DDS domain in " + std::to_string(kAutoDomainFirst) + ".." +
-                           std::to_string(kAutoDomainLast) + " (give one with --domain N)");
+  throw std::runtime_error("no free DDS domain in " + std::to_string(kFreeDomainFirst) + ".." +
+                           std::to_string(kFreeDomainLast) + " (give one with --domain N)");
 }
 
 }  // namespace bbw::launch

@@ -1,7 +1,7 @@
 // The DDS domain a run uses when none is given (no --domain, no BBW_DOMAIN): a free one.
 //
 // Rule (docs/distributed.md, "Runs on one host"): the launcher walks the domains
-// kAutoDomainFirst..kAutoDomainLast, starting at an offset taken from its run id, and takes the
+// kFreeDomainFirst..kFreeDomainLast, starting at an offset taken from its run id, and takes the
 // first one that (1) no other bbw_launch holds (an flock on /tmp/bbw-domain-<d>.lock, held until
 // this launcher exits, so two launchers never pick the same one) and (2) no DDS participant on
 // this host uses (the UDP port of its participant 0, 7410 + 250 d, can be bound on 127.0.0.1).
@@ -14,8 +14,8 @@
 
 namespace bbw::launch {
 
-inline constexpr int kAutoDomainFirst = 100;
-inline constexpr int kAutoDomainLast = 159;
+inline constexpr int kFreeDomainFirst = 100;
+inline constexpr int kFreeDomainLast = 159;
 
 // Holds the claim on one domain (its lock file) until destroyed.
 class DomainClaim {
