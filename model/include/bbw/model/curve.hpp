@@ -1,7 +1,7 @@
 // The characteristic curve: clamp force as a cubic in actuator position.
 #pragma once
 
-namespace bbw::calibration {
+namespace bbw::model {
 
 struct Curve {
   double a = 0.0;  // kN/rev^3
@@ -12,4 +12,10 @@ struct Curve {
   double force_kN(double x_rev) const { return ((a * x_rev + b) * x_rev + c) * x_rev + d; }
 };
 
+}  // namespace bbw::model
+
+// The names where they lived before model/ existed (bbw::calibration), so code written against them
+// keeps compiling; new code says bbw::model.
+namespace bbw::calibration {
+using model::Curve;
 }  // namespace bbw::calibration

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace bbw::common {
+namespace bbw::model {
 
 class DelayLine {
  public:
@@ -59,4 +59,10 @@ class DelayLine {
   std::size_t size_ = 0;
 };
 
+}  // namespace bbw::model
+
+// The names where they lived before model/ existed (bbw::common), so code written against them
+// keeps compiling; new code says bbw::model.
+namespace bbw::common {
+using model::DelayLine;
 }  // namespace bbw::common

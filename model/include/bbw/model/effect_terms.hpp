@@ -13,7 +13,7 @@
 
 #include "bbw/model/play.hpp"
 
-namespace bbw::calibration {
+namespace bbw::model {
 
 // The values of the terms, as the calibrator is configured and as a corner replays them.
 struct EffectTermValues {
@@ -134,4 +134,21 @@ inline int effect_columns(const EffectTermValues& v) {
   return std::apply([&](auto... term) { return (decltype(term)::columns(v) + ...); }, EffectTerms{});
 }
 
+}  // namespace bbw::model
+
+// The names where they lived before model/ existed (bbw::calibration), so code written against them
+// keeps compiling; new code says bbw::model.
+namespace bbw::calibration {
+using model::EffectTermValues;
+using model::TermBound;
+using model::kNoUpperBound;
+using model::TermViolation;
+using model::ViscousTerm;
+using model::ForceDelayTerm;
+using model::BacklashTerm;
+using model::LoadFrictionTerm;
+using model::LoadCellOffsetTerm;
+using model::EffectTerms;
+using model::check_effect_terms;
+using model::effect_columns;
 }  // namespace bbw::calibration

@@ -14,7 +14,7 @@
 #include "bbw/model/effect_terms.hpp"
 #include "bbw/model/maxwell_slip.hpp"
 
-namespace bbw::calibration {
+namespace bbw::model {
 
 struct FrictionModel {
   std::vector<double> delta_rev;             // thresholds Delta_i
@@ -71,4 +71,11 @@ class FrictionTracker {
   bool started_ = false;
 };
 
+}  // namespace bbw::model
+
+// The names where they lived before model/ existed (bbw::calibration), so code written against them
+// keeps compiling; new code says bbw::model.
+namespace bbw::calibration {
+using model::FrictionModel;
+using model::FrictionTracker;
 }  // namespace bbw::calibration

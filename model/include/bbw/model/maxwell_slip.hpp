@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstddef>
 
-namespace bbw::calibration {
+namespace bbw::model {
 
 // Normalised deflection n_i of one element at input x, given its position x_i, and the
 // element position after the sample (x_i stays when sticking, follows x at Delta_i when slipping).
@@ -49,4 +49,12 @@ inline void thresholds(std::size_t m, double delta_max_rev, bool geometric, doub
   }
 }
 
+}  // namespace bbw::model
+
+// The names where they lived before model/ existed (bbw::calibration), so code written against them
+// keeps compiling; new code says bbw::model.
+namespace bbw::calibration {
+using model::element_step;
+using model::elements_step;
+using model::thresholds;
 }  // namespace bbw::calibration

@@ -2,7 +2,7 @@
 // play. Pure arithmetic; shared by the plant, the calibrator's backlash term and the corners.
 #pragma once
 
-namespace bbw::calibration {
+namespace bbw::model {
 
 // Backlash: one step of the play operator. `spindle_rev` (the state) is dragged along so that it
 // stays within half the play of the resolver position; returns it.
@@ -13,4 +13,10 @@ inline double play_step(double& spindle_rev, double x_rev, double width_rev) {
   return spindle_rev;
 }
 
+}  // namespace bbw::model
+
+// The names where they lived before model/ existed (bbw::calibration), so code written against them
+// keeps compiling; new code says bbw::model.
+namespace bbw::calibration {
+using model::play_step;
 }  // namespace bbw::calibration

@@ -4,7 +4,7 @@
 
 #include <cstddef>
 
-namespace bbw::calibration {
+namespace bbw::model {
 
 // When the element states are known whatever the friction's initial deflection: once x has
 // moved 2 Delta_max from its running lowest or highest position, every element (the real
@@ -44,4 +44,11 @@ inline std::size_t first_known_sample(const double* x, std::size_t n, double del
   return n;
 }
 
+}  // namespace bbw::model
+
+// The names where they lived before model/ existed (bbw::calibration), so code written against them
+// keeps compiling; new code says bbw::model.
+namespace bbw::calibration {
+using model::StatesKnown;
+using model::first_known_sample;
 }  // namespace bbw::calibration
