@@ -9,6 +9,7 @@
 #include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/faults/link_faults.hpp"
+#include "bbw/runtime/period_clock.hpp"
 #include "bbw/runtime/run_stats.hpp"
 #include "bbw/node/csv_log.hpp"
 #include "bbw/security/dds_security.hpp"
@@ -187,8 +188,12 @@ int CcuApp::run(std::string& error) {
   if (!wait_for_corners(error)) return events_.interrupted() ? kExitOk : kExitDiscovery;
   // Initial model: every corner knows the thresholds and initial curve before period 0.
   for (const msg::CalibrationState& s : node_.initial_states()) calibration_.send(s);
-  const double T = scenario_.ccu_period_s;
-  t0_ = Clock::now();
+  // The clock policy (bbw/runtime/period_clock.hpp): lockstep, period k begins when every
+  // live corner's block k is in; realtime, at t0 + k * T, inputs drained as they come.
+  const auto clock = runtime::make_period_clock(options_.mode, events_, scenario_.ccu_period_s, options_.peer_timeout,
+                                                /*poll_while_waiting=*/true);
+  clock->start(0);
+  t0_ = clock->started_at();
   int rc = kExitOk;
   std::uint32_t expected_incarnation[kSlots] = {};
   if (options_.mode == ClockMode::Lockstep) {
@@ -212,13 +217,8 @@ int CcuApp::run(std::string& error) {
         drain_qos_events(t_end, true);
         return node_.period_complete(k);
       };
-      const auto give_up = Clock::now() + options_.peer_timeout;
-      bool ok = false;
-      for (;;) {
-        ok = events_.wait_until(std::min(give_up, Clock::now() + std::chrono::milliseconds(200)), pred);
-        if (ok || events_.interrupted() || Clock::now() >= give_up) break;
-        send_commands(k, false, false);
-      }
+      const runtime::PeriodStart begun = clock->begin(k, pred, [&] { send_commands(k, false, false); });
+      const bool ok = begun == runtime::PeriodStart::Go;
       if (const std::string failed = node_.end_lockstep_period(k, t_end); !failed.empty()) {
         error = "corner " + failed + " reported failure at period " + std::to_string(k);
         rc = kExitPeerLost;
@@ -239,16 +239,14 @@ int CcuApp::run(std::string& error) {
     // sends every corner its command for the next period; QoS events are handled as they come.
     send_commands(0, false);
     for (std::uint64_t k = 1; k <= periods_ && !events_.interrupted(); ++k) {
-      const auto wake = t0_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
-                                  static_cast<double>(k) * T));
-      events_.wait_until(wake, [&] {
+      const runtime::PeriodStart begun = clock->begin(k, [&] {
         drain_blocks(0.0);
         drain_health();
         drain_qos_events(0.0, false);
         return false;
       });
-      if (events_.interrupted()) break;
-      const double t_k = static_cast<double>(k) * T;
+      if (begun == runtime::PeriodStart::Interrupted) break;
+      const double t_k = static_cast<double>(k) * scenario_.ccu_period_s;
       node_.after_period(realtime_now_s());
       periods_done_ = k;
       if (k == periods_) break;
@@ -264,7 +262,7 @@ int CcuApp::run(std::string& error) {
     node_.record_detections();
   }
   wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
-  sim_s_ = static_cast<double>(periods_done_) * T;
+  sim_s_ = static_cast<double>(periods_done_) * scenario_.ccu_period_s;
   send_commands(periods_, true);
   for (auto& c : commands_) c->get().get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
   if (log_ != nullptr) log_->flush();

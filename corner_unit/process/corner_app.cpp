@@ -12,6 +12,7 @@
 
 #include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
+#include "bbw/runtime/period_clock.hpp"
 #include "bbw/runtime/run_stats.hpp"
 #include "bbw/node/csv_log.hpp"
 
@@ -175,9 +176,13 @@ int CornerApp::run(std::string& error) {
   const std::uint64_t first = node_.start();
   publish_health(msg::HEALTH_RUNNING);
 
-  const auto period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(scenario_.ccu_period_s));
-  t0_ = Clock::now();
+  // The clock policy (bbw/runtime/period_clock.hpp): lockstep, the command for period k is the
+  // grant to simulate it; realtime, period k starts at t0 + (k - first) * period.
+  const auto clock = runtime::make_period_clock(options_.mode, events_, scenario_.ccu_period_s, options_.peer_timeout,
+                                                /*poll_while_waiting=*/false);
+  const bool lockstep = clock->mode() == ClockMode::Lockstep;
+  clock->start(first);
+  t0_ = clock->started_at();
   started_ = true;
   CornerStats& stats = node_.stats();
   for (std::uint64_t k = first; k < node_.periods(); ++k) {
@@ -185,35 +190,28 @@ int CornerApp::run(std::string& error) {
       finish_stats(wall0);
       freeze_for_kill();
     }
-    if (options_.mode == ClockMode::Lockstep) {
-      if (!node_.ccu_lost()) {
-        // The command for period k is the grant to simulate it. Without a CCU (its command
-        // writer lost its liveliness) the corner runs on alone under its watchdog.
-        const bool granted = events_.wait_for(options_.peer_timeout, [&] {
-          drain_inputs();
-          return node_.granted(k) || ccu_gone();
-        });
-        if (events_.interrupted()) break;
-        if (!granted) {
-          error = "no command for period " + std::to_string(k) + " from the CCU within " +
-                  std::to_string(options_.peer_timeout.count()) + " ms";
-          publish_health(msg::HEALTH_FAILED);
-          return kExitPeerLost;
-        }
-        if (node_.latest_command().stop()) break;
-        if (!node_.granted(k)) node_.set_ccu_lost();  // only ccu_gone() ends the wait without a grant
+    // Lockstep without a CCU (its command writer lost its liveliness): the corner runs on alone
+    // under its watchdog.
+    if (!lockstep || !node_.ccu_lost()) {
+      const runtime::PeriodStart begun = clock->begin(k, [&] {
+        drain_inputs();
+        return node_.granted(k) || ccu_gone();
+      });
+      if (begun == runtime::PeriodStart::Interrupted) break;
+      if (begun == runtime::PeriodStart::TimedOut) {
+        error = "no command for period " + std::to_string(k) + " from the CCU within " +
+                std::to_string(options_.peer_timeout.count()) + " ms";
+        publish_health(msg::HEALTH_FAILED);
+        return kExitPeerLost;
       }
-    } else {
-      // Pace on the wall clock: period k starts at t0 + (k - first) * period.
-      const auto wake = t0_ + period * static_cast<long long>(k - first);
-      events_.wait_until(wake, [&] { return events_.interrupted(); });
-      if (events_.interrupted()) break;
-      const double late_s = std::chrono::duration<double>(Clock::now() - wake).count();
-      jitter_sum_s_ += late_s;
-      if (late_s > stats.max_jitter_s) stats.max_jitter_s = late_s;
-      if (late_s > scenario_.ccu_period_s) ++stats.overruns;
-      drain_inputs();
+      if (!lockstep) {
+        const double late_s = clock->late_s();
+        jitter_sum_s_ += late_s;
+        if (late_s > stats.max_jitter_s) stats.max_jitter_s = late_s;
+        if (late_s > scenario_.ccu_period_s) ++stats.overruns;
+      }
       if (node_.latest_command().stop()) break;
+      if (lockstep && !node_.granted(k)) node_.set_ccu_lost();  // only ccu_gone() ends the wait without a grant
     }
     simulate_period(k);
   }
