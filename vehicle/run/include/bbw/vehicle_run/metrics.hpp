@@ -1,0 +1,43 @@
+// The `vehicle` object of summary.json (docs/vehicle.md): stopping distance against the physical
+// limit of the tyre model, UN R13-H Annex 6 adhesion utilisation, wheel lock, slip, yaw and
+// lateral deviation, mean deceleration.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "bbw/common/json.hpp"
+#include "bbw/vehicle_run/vehicle_run.hpp"
+
+namespace bbw::vehicle_run {
+
+struct VehicleMetrics {
+  bool stopped = false;
+  double onset_speed_m_s = 0.0;
+  double stopping_distance_m = 0.0;       // from the pedal's first travel to standstill
+  double stopping_time_s = 0.0;
+  double mu_peak = 0.0;                   // the tyre model's peak at the start surface, with load transfer
+  double ideal_stopping_distance_m = 0.0; // v^2 / (2 mu_peak g)
+  double distance_ratio = 0.0;
+  // UN R13-H Annex 6 Appendix 2: z_AL = 0.849 / t(45 -> 15 km/h) measured in this run; k_M from the
+  // tyre model's per-axle adhesion at the axles' dynamic loads (the regulation's per-axle runs
+  // without anti-lock are not simulated); epsilon = z_AL / k_M. NaN when the run did not pass
+  // 45 and 15 km/h.
+  double z_AL = 0.0;
+  double k_M = 0.0;
+  double adhesion_utilisation = 0.0;
+  std::array<double, 4> wheel_lock_s{};
+  std::array<double, 4> longest_wheel_lock_s{};
+  std::array<double, 4> slip_rms{};       // while braking above 15 km/h
+  double max_yaw_rate_deg_s = 0.0;
+  double max_lateral_deviation_m = 0.0;   // from the driver's path (straight: |y|)
+  double mean_deceleration_g = 0.0;       // onset speed / stopping time / g
+};
+
+VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleRun& run);
+void write_vehicle_json(json::Writer& w, const VehicleMetrics& m);
+// The tyre model's peak adhesion for a straight stop on `surface` (deceleration z at which every
+// wheel is at its peak at its dynamic load), and the per-axle adhesion k at deceleration z.
+double peak_adhesion(const vehicle::VehicleParams& p, const vehicle::Surface& surface);
+
+}  // namespace bbw::vehicle_run

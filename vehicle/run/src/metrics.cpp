@@ -1,0 +1,128 @@
+#include "bbw/vehicle_run/metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "bbw/vehicle/tyre.hpp"
+
+namespace bbw::vehicle_run {
+
+namespace {
+constexpr double kG = 9.81;
+
+struct AxleLoads {
+  double front_N, rear_N;
+};
+AxleLoads axle_loads(const vehicle::ChassisParams& c, double z) {
+  const double L = c.wheelbase_m();
+  const double W = c.mass_kg * kG;
+  return {W * (c.cg_to_rear_axle_m + c.cg_height_m * z) / L, W * (c.cg_to_front_axle_m - c.cg_height_m * z) / L};
+}
+double axle_mu(const vehicle::VehicleParams& p, const vehicle::Surface& s, double axle_N) {
+  return vehicle::peak_longitudinal_mu(p.tyre, 0.5 * axle_N, s.mu_scale, s.stiffness_scale).mu;
+}
+}  // namespace
+
+double peak_adhesion(const vehicle::VehicleParams& p, const vehicle::Surface& surface) {
+  double z = axle_mu(p, surface, 0.5 * p.chassis.mass_kg * kG);
+  for (int i = 0; i < 50; ++i) {
+    const AxleLoads a = axle_loads(p.chassis, z);
+    z = (axle_mu(p, surface, a.front_N) * a.front_N + axle_mu(p, surface, a.rear_N) * a.rear_N) / (p.chassis.mass_kg * kG);
+  }
+  return z;
+}
+
+VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleRun& run) {
+  VehicleMetrics m;
+  const vehicle::VehicleParams& p = s.vehicle.vehicle;
+  const auto& tr = run.trace();
+  m.stopped = run.stop_time_s() >= 0.0;
+  m.onset_speed_m_s = run.onset_speed_m_s();
+  const double end_path = tr.empty() ? 0.0 : tr.back().path_m;
+  m.stopping_distance_m = end_path - run.onset_path_m();
+  m.stopping_time_s = m.stopped ? run.stop_time_s() - run.brake_onset_s() : std::numeric_limits<double>::quiet_NaN();
+  const vehicle::Surface& start_surface = s.road.surface_at(0.0, 0.0);
+  m.mu_peak = peak_adhesion(p, start_surface);
+  m.ideal_stopping_distance_m = m.onset_speed_m_s * m.onset_speed_m_s / (2.0 * m.mu_peak * kG);
+  m.distance_ratio = m.stopped ? m.stopping_distance_m / m.ideal_stopping_distance_m : std::numeric_limits<double>::quiet_NaN();
+  // z_AL from the time between 45 and 15 km/h (interpolated between periods).
+  double t45 = -1.0, t15 = -1.0;
+  for (std::size_t i = 1; i < tr.size(); ++i) {
+    auto cross = [&](double v_kmh, double& t) {
+      const double v = v_kmh / 3.6;
+      if (t < 0.0 && tr[i - 1].speed_m_s > v && tr[i].speed_m_s <= v) {
+        const double f = (tr[i - 1].speed_m_s - v) / (tr[i - 1].speed_m_s - tr[i].speed_m_s);
+        t = tr[i - 1].time_s + f * (tr[i].time_s - tr[i - 1].time_s);
+      }
+    };
+    cross(45.0, t45);
+    cross(15.0, t15);
+  }
+  if (t45 >= 0.0 && t15 > t45) {
+    m.z_AL = 0.849 / (t15 - t45);
+    const AxleLoads dyn = axle_loads(p.chassis, m.z_AL);
+    // Per-axle adhesion: each axle braked alone at its peak (the regulation's k_f, k_r).
+    auto axle_alone = [&](bool front) {
+      double z = 0.5;
+      for (int i = 0; i < 50; ++i) {
+        const AxleLoads a = axle_loads(p.chassis, front ? z : -z);
+        const double axle = front ? a.front_N : a.rear_N;
+        z = axle_mu(p, start_surface, axle) * axle / (p.chassis.mass_kg * kG);
+      }
+      const AxleLoads a = axle_loads(p.chassis, front ? z : -z);
+      return axle_mu(p, start_surface, front ? a.front_N : a.rear_N);
+    };
+    const double k_f = axle_alone(true), k_r = axle_alone(false);
+    m.k_M = (k_f * dyn.front_N + k_r * dyn.rear_N) / (p.chassis.mass_kg * kG);
+    m.adhesion_utilisation = m.z_AL / m.k_M;
+  } else {
+    m.z_AL = m.k_M = m.adhesion_utilisation = std::numeric_limits<double>::quiet_NaN();
+  }
+  m.wheel_lock_s = run.wheel_lock_s();
+  m.longest_wheel_lock_s = run.longest_lock_s();
+  std::array<double, 4> sum{};
+  std::size_t count = 0;
+  for (const PeriodTrace& t : tr) {
+    m.max_yaw_rate_deg_s = std::max(m.max_yaw_rate_deg_s, std::abs(t.yaw_rate_rad_s) * 180.0 / M_PI);
+    const double dev = std::abs(vehicle::path_error(s.driver ? s.driver_params.path_radius_m : 0.0, t.x_m, t.y_m, t.yaw_rad).lateral_m);
+    m.max_lateral_deviation_m = std::max(m.max_lateral_deviation_m, dev);
+    if (t.demand > 0.0 && t.speed_m_s > 15.0 / 3.6) {
+      for (std::size_t w = 0; w < 4; ++w) sum[w] += t.slip[w] * t.slip[w];
+      ++count;
+    }
+  }
+  for (std::size_t w = 0; w < 4; ++w) m.slip_rms[w] = count ? std::sqrt(sum[w] / count) : 0.0;
+  m.mean_deceleration_g = m.stopped ? m.onset_speed_m_s / m.stopping_time_s / kG : std::numeric_limits<double>::quiet_NaN();
+  return m;
+}
+
+void write_vehicle_json(json::Writer& w, const VehicleMetrics& m) {
+  static const char* names[4] = {"FL", "FR", "RL", "RR"};
+  w.begin_object("vehicle");
+  w.value("stopped", m.stopped);
+  w.value("onset_speed_km_h", m.onset_speed_m_s * 3.6);
+  w.value("stopping_distance_m", m.stopping_distance_m);
+  w.value("stopping_time_s", m.stopping_time_s);
+  w.value("mu_peak", m.mu_peak);
+  w.value("ideal_stopping_distance_m", m.ideal_stopping_distance_m);
+  w.value("distance_ratio", m.distance_ratio);
+  w.value("z_AL", m.z_AL);
+  w.value("k_M", m.k_M);
+  w.value("adhesion_utilisation", m.adhesion_utilisation);
+  w.begin_object("wheel_lock_s");
+  for (std::size_t i = 0; i < 4; ++i) w.value(names[i], m.wheel_lock_s[i]);
+  w.end_object();
+  w.begin_object("longest_wheel_lock_s");
+  for (std::size_t i = 0; i < 4; ++i) w.value(names[i], m.longest_wheel_lock_s[i]);
+  w.end_object();
+  w.begin_object("slip_rms");
+  for (std::size_t i = 0; i < 4; ++i) w.value(names[i], m.slip_rms[i]);
+  w.end_object();
+  w.value("max_yaw_rate_deg_s", m.max_yaw_rate_deg_s);
+  w.value("max_lateral_deviation_m", m.max_lateral_deviation_m);
+  w.value("mean_deceleration_g", m.mean_deceleration_g);
+  w.end_object();
+}
+
+}  // namespace bbw::vehicle_run
