@@ -128,6 +128,7 @@ int main(int argc, char** argv) {
       options.in_process.friction_feedback = feedback == "compensated";
     }
     options.exchange_every_samples = exchange_every;
+    options.in_process.process_faults = true;  // a corner kill in a vehicle scenario is carried out in process
   } catch (const bbw::config::ConfigError& e) {
     std::cerr << "bbw_vehicle_inproc: " << e.what() << "\n";
     return 2;

@@ -59,7 +59,12 @@ VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleRun& run) 
     cross(45.0, t45);
     cross(15.0, t15);
   }
-  if (t45 >= 0.0 && t15 > t45) {
+  const bool uniform = s.road.patches.empty();
+  if (!uniform) {
+    // Not defined on split or jumping surfaces: no single mu_peak.
+    m.ideal_stopping_distance_m = m.distance_ratio = std::numeric_limits<double>::quiet_NaN();
+  }
+  if (uniform && t45 >= 0.0 && t15 > t45) {
     m.z_AL = 0.849 / (t15 - t45);
     const AxleLoads dyn = axle_loads(p.chassis, m.z_AL);
     // Per-axle adhesion: each axle braked alone at its peak (the regulation's k_f, k_r).
