@@ -164,7 +164,7 @@ const VehicleState& Vehicle::step(double dt_s, const VehicleInputs& in) {
   s_.path_m += std::hypot(dx, dy);
   s_.yaw_rad += dt_s * s_.yaw_rate_rad_s;
   s_.time_s += dt_s;
-  if (braking_any && !driving_any && s_.vx_m_s <= c.stop_speed_m_s) {
+  if (braking_any && !driving_any && std::hypot(s_.vx_m_s, s_.vy_m_s) <= c.stop_speed_m_s) {
     s_.stopped = true;
     s_.vx_m_s = s_.vy_m_s = s_.yaw_rate_rad_s = 0.0;
     for (WheelState& ws : s_.wheels) ws.spin_rad_s = 0.0;

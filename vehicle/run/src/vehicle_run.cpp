@@ -71,7 +71,7 @@ void VehicleRun::vehicle_period(std::uint64_t k) {
       if (every == 1 || global % static_cast<std::uint64_t>(every) == 0) in.clamp_force_kN[w] = force[w][j];
     }
     const vehicle::VehicleState& st = vehicle_.state();
-    if (driver_) in.steer_rad = driver_->steer(dt_s_, st.x_m, st.y_m, st.yaw_rad, vehicle_.speed_m_s());
+    if (driver_) in.steer_rad = driver_->steer(dt_s_, st.x_m, st.y_m, st.yaw_rad, vehicle_.speed_m_s(), st.yaw_rate_rad_s);
     vehicle_.step(dt_s_, in);
     const vehicle::VehicleState& s = vehicle_.state();
     for (std::size_t w = 0; w < 4; ++w) wheel_sensors_[w].update(s.wheels[w].angle_rad, s.time_s);

@@ -96,6 +96,7 @@ VehicleScenario load_vehicle_scenario(const std::string& file) {
     s.driver_params.path_radius_m = d->number("path_radius_m");
     s.driver_params.preview_s = d->number("preview_s", Range::non_negative());
     s.driver_params.gain_rad_per_m = d->number("gain_rad_per_m", Range::non_negative());
+    s.driver_params.yaw_rate_gain_s = d->number("yaw_rate_gain_s", Range::closed(0, 2));
     s.driver_params.reaction_s = d->number("reaction_s", Range::closed(0, 0.5));
     s.driver_params.lag_s = d->number("lag_s", Range::positive());
     s.driver_params.max_rate_rad_s = d->number("max_rate_rad_s", Range::positive());

@@ -13,6 +13,7 @@ struct DriverParams {
   double path_radius_m = 0.0;        // 0: straight; > 0 left turn, < 0 right turn
   double preview_s = 0.8;            // look-ahead time
   double gain_rad_per_m = 0.02;      // steering per metre of previewed offset
+  double yaw_rate_gain_s = 0.0;      // counter-steer per rad/s of yaw rate beyond the path's (rad per rad/s)
   double reaction_s = 0.15;          // delay from seeing to steering
   double lag_s = 0.1;                // steering first-order lag
   double max_rate_rad_s = 0.6;       // road-wheel steering rate limit
@@ -33,7 +34,7 @@ class Driver {
  public:
   Driver(const DriverParams& p, double wheelbase_m);
   // Steering for the next step given where the car is; dt_s the step.
-  double steer(double dt_s, double x_m, double y_m, double yaw_rad, double speed_m_s);
+  double steer(double dt_s, double x_m, double y_m, double yaw_rad, double speed_m_s, double yaw_rate_rad_s = 0.0);
   double steer_rad() const { return steer_rad_; }
 
  private:

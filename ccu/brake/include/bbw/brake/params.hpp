@@ -58,8 +58,11 @@ struct SlipControlParams {
 struct YawLimitParams {
   bool enabled = true;
   double asymmetry_ratio = 0.6;         // a front wheel's ABS torque below this share of the other's: split-mu
-  double ramp_Nm_per_s = 1500.0;        // how fast the high side may exceed the low side
+  double ramp_Nm_per_s = 1000.0;        // how fast the high side may exceed the low side
   double initial_Nm = 200.0;
+  // Yaw-rate feedback (from measurements only): the yaw rate beyond the one the lateral
+  // acceleration explains (r - a_y / v, the sideslip's growth) takes torque off the high side.
+  double yaw_error_gain_Nm_per_rad_s = 8000.0;
   bool rear_select_low = true;
 };
 
