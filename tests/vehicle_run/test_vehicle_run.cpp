@@ -94,3 +94,20 @@ TEST(VehicleRun, WithoutABSTheWheelsLock) {
   for (double l : m.longest_wheel_lock_s) longest = std::max(longest, l);
   EXPECT_GT(longest, 0.5);
 }
+
+TEST(VehicleRun, TheCaliperTemperatureComesFromTheDriving) {
+  auto s = vehicle_run::load_vehicle_scenario(scen("dry_straight_100kmh"));
+  s.disc_C = {400.0, 40.0, 40.0, 40.0};  // FL's disc hot: its caliper warms during the run
+  vehicle_run::VehicleRun r(s, calibrator(), {});
+  auto fl = r.in_process().block_topic(0).receiver();
+  r.run();
+  msg::MeasurementBlock b, last;
+  while (fl->take(b)) {
+    if (!b.samples().empty()) last = b;
+  }
+  ASSERT_FALSE(last.samples().empty());
+  const double sensed = last.samples().back().temperature_C();
+  const double vehicle_C = r.vehicle().state().wheels[0].caliper_C;
+  EXPECT_GT(vehicle_C, s.caliper_C[0] + 2.0);
+  EXPECT_NEAR(sensed, vehicle_C, 0.5);  // the plant's temperature sensor reads the vehicle's caliper
+}

@@ -120,7 +120,8 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
     const double lo = std::min(out_.torque_Nm[0], out_.torque_Nm[1]);
     const double hi = std::max(out_.torque_Nm[0], out_.torque_Nm[1]);
     const std::size_t low_side = out_.torque_Nm[0] <= out_.torque_Nm[1] ? 0 : 1;
-    const bool asym = out_.wheels[low_side].active && hi > 0.0 && lo < p_.yaw.asymmetry_ratio * hi;
+    const bool asym = out_.wheels[low_side].active && hi > 0.0 && lo < p_.yaw.asymmetry_ratio * hi &&
+                      hi - lo > p_.yaw.min_difference_Nm;
     if (asym && !split_) {
       split_ = true;
       split_s_ = 0.0;

@@ -67,6 +67,7 @@ BrakeControlParams read_brake_control(Reader& r) {
     Reader c = r.map("yaw_limit");
     p.yaw.enabled = c.boolean("enabled");
     p.yaw.asymmetry_ratio = c.number("asymmetry_ratio", Range{0.0, 1.0, true, true});
+    p.yaw.min_difference_Nm = c.number("min_difference_Nm", Range::non_negative());
     p.yaw.ramp_Nm_per_s = c.number("ramp_Nm_per_s", Range::positive());
     p.yaw.initial_Nm = c.number("initial_Nm", Range::non_negative());
     p.yaw.yaw_error_gain_Nm_per_rad_s = c.number("yaw_error_gain_Nm_per_rad_s", Range::non_negative());

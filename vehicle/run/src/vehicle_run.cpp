@@ -42,6 +42,8 @@ VehicleRun::VehicleRun(const VehicleScenario& s, const calibration::CalibratorCo
   for (std::size_t w = 0; w < 4; ++w) meas_.wheel_rad_s[w] = vehicle_.state().wheels[w].spin_rad_s;
 }
 
+double VehicleRun::caliper_temperature_C(std::size_t slot) const { return vehicle_.state().wheels[slot].caliper_C; }
+
 void VehicleRun::vehicle_period(std::uint64_t k) {
   // The corners' true clamp forces of period k, per wheel slot, one per plant step.
   const std::size_t n = static_cast<std::size_t>(std::llround(run_.ccu().period_end_s(k) / dt_s_)) -
@@ -107,6 +109,11 @@ void VehicleRun::vehicle_period(std::uint64_t k) {
   const vehicle::PedalReading pr = pedal_.read(t_end);
   meas_.pedal_travel_mm = pr.travel_mm;
   meas_.pedal_force_N = pr.force_N;
+  // The caliper temperatures the vehicle computed reach the corners' plants from the next period
+  // (over DDS they would travel in the vehicle's message; in process the node is at hand).
+  for (std::size_t i = 0; i < run_.corners(); ++i) {
+    run_.corner(i).set_caliper_temperature_C(caliper_temperature_C(slot_of_channel_[i]));
+  }
   run_.ccu().participant_done(vehicle_participant_, k);
   run_.ccu().participant_done(pedal_participant_, k);
   // Trace.

@@ -58,6 +58,7 @@ struct SlipControlParams {
 struct YawLimitParams {
   bool enabled = true;
   double asymmetry_ratio = 0.6;         // a front wheel's ABS torque below this share of the other's: split-mu
+  double min_difference_Nm = 300.0;     // ... and more than this apart (noise on low mu is no split)
   double ramp_Nm_per_s = 1000.0;        // how fast the high side may exceed the low side
   double initial_Nm = 200.0;
   // Yaw-rate feedback (from measurements only): the yaw rate beyond the one the lateral

@@ -77,6 +77,7 @@ class VehicleRun {
 
  private:
   void vehicle_period(std::uint64_t k);
+  double caliper_temperature_C(std::size_t slot) const;
 
   const VehicleScenario& scenario_;
   VehicleRunOptions options_;
