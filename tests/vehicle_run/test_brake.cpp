@@ -21,6 +21,7 @@ TEST(PedalDemand, AgreeingSensorsAverageAndAFailedOneCannotTakeTheBrakeAway) {
 }
 
 TEST(SpeedEstimator, FollowsTheIMUWhileTheWheelsSlip) {
+  // The IMU reads the deceleration; every wheel slips 12 %, the slip the controllers hold.
   SpeedEstimatorParams p;
   SpeedEstimator e(p, 0.344);
   double v = 25.0;
@@ -28,7 +29,7 @@ TEST(SpeedEstimator, FollowsTheIMUWhileTheWheelsSlip) {
   for (int i = 0; i < 400; ++i) {
     v -= 8.0 * 0.005;
     const double w = 0.88 * v / 0.344;  // every wheel at 12 % slip
-    e.update(0.005, {w, w, w, w}, -8.0, true);
+    e.update(0.005, {w, w, w, w}, -8.0, true, 0.12);  // the slip controllers hold 12 %
   }
   EXPECT_NEAR(e.speed_m_s(), v, 0.03 * 25.0);
   EXPECT_GT(e.speed_m_s(), 0.93 * v);  // not dragged down to the slipping wheels

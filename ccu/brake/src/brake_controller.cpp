@@ -75,8 +75,13 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
   const double z_request = pd.demand * p_.pedal.full_demand_g;
   out_.decel_request_g = z_request;
   bool any_active = false;
-  for (const SlipController& s : slip_) any_active = any_active || s.last().active;
-  const double v = speed_.update(dt_s, m.wheel_rad_s, m.ax_m_s2, any_active || z_request > 0.3);
+  double held_slip = 1.0;
+  for (const SlipController& s : slip_) {
+    any_active = any_active || s.last().active;
+    if (s.last().active) held_slip = std::min(held_slip, s.target_slip());
+  }
+  if (!any_active) held_slip = 0.0;
+  const double v = speed_.update(dt_s, m.wheel_rad_s, m.ax_m_s2, any_active || z_request > 0.3, held_slip);
   out_.speed_estimate_m_s = v;
   // Load transfer at the measured deceleration (never more than requested).
   ax_filt_ += std::min(1.0, dt_s / 0.03) * (m.ax_m_s2 - ax_filt_);

@@ -31,7 +31,7 @@ struct PedalDemandParams {
 
 struct SpeedEstimatorParams {
   double up_gain_per_s = 50.0;          // towards the fastest wheel when it reads faster
-  double down_gain_per_s = 0.05;        // towards it when it reads slower while braking hard
+  double down_gain_per_s = 0.5;         // towards it when it reads slower while braking hard
   double rolling_gain_per_s = 20.0;     // towards it when no wheel is braked hard
   double bias_gain_per_s = 0.5;         // IMU bias learning while rolling freely
   double wheel_filter_s = 0.005;
