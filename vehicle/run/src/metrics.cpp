@@ -33,10 +33,10 @@ double peak_adhesion(const vehicle::VehicleParams& p, const vehicle::Surface& su
   return z;
 }
 
-VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleRun& run) {
+VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleNode& run) {
   VehicleMetrics m;
   const vehicle::VehicleParams& p = s.vehicle.vehicle;
-  const auto& tr = run.trace();
+  const auto& tr = run.truth();
   m.stopped = run.stop_time_s() >= 0.0;
   m.onset_speed_m_s = run.onset_speed_m_s();
   const double end_path = tr.empty() ? 0.0 : tr.back().path_m;
@@ -88,11 +88,11 @@ VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleRun& run) 
   m.longest_wheel_lock_s = run.longest_lock_s();
   std::array<double, 4> sum{};
   std::size_t count = 0;
-  for (const PeriodTrace& t : tr) {
+  for (const TruthRow& t : tr) {
     m.max_yaw_rate_deg_s = std::max(m.max_yaw_rate_deg_s, std::abs(t.yaw_rate_rad_s) * 180.0 / M_PI);
     const double dev = std::abs(vehicle::path_error(s.driver ? s.driver_params.path_radius_m : 0.0, t.x_m, t.y_m, t.yaw_rad).lateral_m);
     m.max_lateral_deviation_m = std::max(m.max_lateral_deviation_m, dev);
-    if (t.demand > 0.0 && t.speed_m_s > 15.0 / 3.6) {
+    if (t.braking && t.speed_m_s > 15.0 / 3.6) {
       for (std::size_t w = 0; w < 4; ++w) sum[w] += t.slip[w] * t.slip[w];
       ++count;
     }

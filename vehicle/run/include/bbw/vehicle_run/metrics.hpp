@@ -34,7 +34,8 @@ struct VehicleMetrics {
   double mean_deceleration_g = 0.0;       // onset speed / stopping time / g
 };
 
-VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleRun& run);
+VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleNode& vehicle);
+inline VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleRun& run) { return vehicle_metrics(s, run.vehicle_node()); }
 void write_vehicle_json(json::Writer& w, const VehicleMetrics& m);
 // The tyre model's peak adhesion for a straight stop on `surface` (deceleration z at which every
 // wheel is at its peak at its dynamic load), and the per-axle adhesion k at deceleration z.

@@ -22,6 +22,7 @@
 #include "bbw/vehicle/pedal.hpp"
 #include "bbw/vehicle/sensors.hpp"
 #include "bbw/vehicle/vehicle.hpp"
+#include "bbw/vehicle_run/vehicle_nodes.hpp"
 #include "bbw/vehicle_run/vehicle_scenario.hpp"
 
 namespace bbw::vehicle_run {
@@ -62,45 +63,35 @@ class VehicleRun {
   bool step();
   void run();
   node::InProcessRun& in_process() { return run_; }
-  const vehicle::Vehicle& vehicle() const { return vehicle_; }
+  const vehicle::Vehicle& vehicle() const { return vehicle_.vehicle(); }
+  const VehicleNode& vehicle_node() const { return vehicle_; }
   const std::vector<PeriodTrace>& trace() const { return trace_; }
-  const brake::BrakeController& brake() const { return brake_; }
+  const brake::BrakeController& brake() const { return brake_.controller(); }
   // Simulated time at which the car stopped (-1: not yet), and its path then.
-  double stop_time_s() const { return stop_time_s_; }
+  double stop_time_s() const { return vehicle_.stop_time_s(); }
   // Time the pedal was first pressed, and the speed then.
-  double brake_onset_s() const { return onset_s_; }
-  double onset_speed_m_s() const { return onset_speed_m_s_; }
-  double onset_path_m() const { return onset_path_m_; }
+  double brake_onset_s() const { return vehicle_.brake_onset_s(); }
+  double onset_speed_m_s() const { return vehicle_.onset_speed_m_s(); }
+  double onset_path_m() const { return vehicle_.onset_path_m(); }
   // Per wheel: seconds with the wheel below half the vehicle speed while above 15 km/h (1 ms steps).
-  const std::array<double, 4>& wheel_lock_s() const { return lock_s_; }
-  const std::array<double, 4>& longest_lock_s() const { return longest_lock_s_; }
+  const std::array<double, 4>& wheel_lock_s() const { return vehicle_.wheel_lock_s(); }
+  const std::array<double, 4>& longest_lock_s() const { return vehicle_.longest_lock_s(); }
 
  private:
   void vehicle_period(std::uint64_t k);
-  double caliper_temperature_C(std::size_t slot) const;
 
   const VehicleScenario& scenario_;
   VehicleRunOptions options_;
   node::InProcessRun run_;
-  vehicle::Vehicle vehicle_;
-  vehicle::Pedal pedal_;
-  vehicle::Imu imu_;
-  std::vector<vehicle::WheelSpeedSensor> wheel_sensors_;
-  std::optional<vehicle::Driver> driver_;
-  brake::BrakeController brake_;
+  VehicleNode vehicle_;
+  PedalNode pedal_;
+  BrakeFunctions brake_;
   std::array<std::unique_ptr<transport::InMemoryTopic<msg::MeasurementBlock>::Receiver>, 4> blocks_in_;
   msg::MeasurementBlock block_;
   std::size_t vehicle_participant_ = 0, pedal_participant_ = 0;
   std::array<std::size_t, 4> slot_of_channel_{};
-  std::array<double, 4> last_force_kN_{};
-  brake::BrakeMeasurements meas_;
-  std::array<double, 4> command_kN_{};
-  std::array<double, 4> estimate_kN_{};
-  double dt_s_ = 0.001;
+  std::array<double, 4> command_kN_{}, estimate_kN_{};
   std::vector<PeriodTrace> trace_;
-  double stop_time_s_ = -1.0;
-  double onset_s_ = -1.0, onset_speed_m_s_ = 0.0, onset_path_m_ = 0.0;
-  std::array<double, 4> lock_s_{}, longest_lock_s_{}, current_lock_s_{};
 };
 
 }  // namespace bbw::vehicle_run
