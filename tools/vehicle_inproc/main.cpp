@@ -146,6 +146,8 @@ int main(int argc, char** argv) {
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const auto m = bbw::vehicle_run::vehicle_metrics(scenario, run);
     write_csv(out_dir + "/vehicle.csv", run.trace());
+    bbw::vehicle_run::write_truth_csv(out_dir + "/vehicle_truth.csv", run.vehicle_node().truth());
+    bbw::vehicle_run::write_vehicle_file(out_dir + "/vehicle.json", m);
     bbw::json::Writer w;
     w.begin_object();
     w.value("scenario", scenario.name);

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <limits>
+#include <stdexcept>
 
 #include "bbw/vehicle/tyre.hpp"
 
@@ -128,6 +131,45 @@ void write_vehicle_json(json::Writer& w, const VehicleMetrics& m) {
   w.value("max_lateral_deviation_m", m.max_lateral_deviation_m);
   w.value("mean_deceleration_g", m.mean_deceleration_g);
   w.end_object();
+}
+
+void write_truth_csv(const std::string& file, const std::vector<TruthRow>& truth) {
+  std::ofstream f(file);
+  if (!f) throw std::runtime_error(file + ": cannot write");
+  f << "time_s,speed_m_s,x_m,y_m,yaw_rad,yaw_rate_rad_s,ax_m_s2,path_m,steer_rad,stopped";
+  static const char* names[4] = {"FL", "FR", "RL", "RR"};
+  for (const char* c : names) {
+    f << ",wheel_speed_" << c << "_m_s,slip_" << c << ",mu_used_" << c << ",clamp_true_" << c << "_kN,brake_torque_" << c
+      << "_Nm,disc_" << c << "_C,caliper_" << c << "_C";
+  }
+  f << "\n";
+  char buf[64];
+  auto num = [&](double v) {
+    std::snprintf(buf, sizeof buf, ",%.17g", v);
+    f << buf;
+  };
+  for (const TruthRow& t : truth) {
+    std::snprintf(buf, sizeof buf, "%.17g", t.time_s);
+    f << buf;
+    for (double v : {t.speed_m_s, t.x_m, t.y_m, t.yaw_rad, t.yaw_rate_rad_s, t.ax_m_s2, t.path_m, t.steer_rad}) num(v);
+    f << (t.stopped ? ",1" : ",0");
+    for (std::size_t w = 0; w < 4; ++w) {
+      for (double v : {t.wheel_speed_m_s[w], t.slip[w], t.mu_used[w], t.clamp_true_kN[w], t.brake_torque_Nm[w], t.disc_C[w],
+                       t.caliper_C[w]}) {
+        num(v);
+      }
+    }
+    f << "\n";
+  }
+  if (!f) throw std::runtime_error(file + ": write failed");
+}
+
+void write_vehicle_file(const std::string& file, const VehicleMetrics& m) {
+  json::Writer w;
+  w.begin_object();
+  write_vehicle_json(w, m);
+  w.end_object();
+  w.save(file);
 }
 
 }  // namespace bbw::vehicle_run

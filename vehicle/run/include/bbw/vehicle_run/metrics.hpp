@@ -37,6 +37,11 @@ struct VehicleMetrics {
 VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleNode& vehicle);
 inline VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleRun& run) { return vehicle_metrics(s, run.vehicle_node()); }
 void write_vehicle_json(json::Writer& w, const VehicleMetrics& m);
+// The vehicle process's and the in-process run's common outputs: the truth per CCU period
+// (vehicle_truth.csv: the same bytes from both, test SystemVehicleRun.*) and the metrics as a
+// JSON document {"vehicle": {...}} (vehicle.json, merged into summary.json by bbw_launch).
+void write_truth_csv(const std::string& file, const std::vector<TruthRow>& truth);
+void write_vehicle_file(const std::string& file, const VehicleMetrics& m);
 // The tyre model's peak adhesion for a straight stop on `surface` (deceleration z at which every
 // wheel is at its peak at its dynamic load), and the per-axle adhesion k at deceleration z.
 double peak_adhesion(const vehicle::VehicleParams& p, const vehicle::Surface& surface);
