@@ -19,7 +19,6 @@
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/common/data_path.hpp"
 #include "bbw/common/json.hpp"
-#include "bbw/common/plot.hpp"
 #include "bbw/common/strict_yaml.hpp"
 #include "bbw/faults/monitor_yaml.hpp"
 #include "bbw/vehicle_run/metrics.hpp"
@@ -57,26 +56,6 @@ void write_csv(const std::string& file, const std::vector<bbw::vehicle_run::Peri
   }
 }
 
-void plots(const std::string& dir, const std::string& name) {
-  using bbw::plot::quote;
-  const std::string csv = quote(dir + "/vehicle.csv");
-  std::ostringstream s;
-  s << "set terminal pngcairo size 1000,600\nset datafile separator ','\nset key autotitle columnhead\nset grid\n"
-    << "set xlabel 'time (s)'\n";
-  s << "set output " << quote(dir + "/speeds.png") << "\nset title '" << name << ": speeds'\nset ylabel 'm/s'\n"
-    << "plot " << csv << " using 1:2 with lines lw 2, '' using 1:3 with lines, '' using 1:11 with lines, '' using 1:21 with lines,"
-    << " '' using 1:31 with lines, '' using 1:41 with lines\n";
-  s << "set output " << quote(dir + "/slips.png") << "\nset title '" << name << ": slip'\nset ylabel 'slip'\n"
-    << "plot " << csv << " using 1:12 with lines, '' using 1:22 with lines, '' using 1:32 with lines, '' using 1:42 with lines\n";
-  s << "set output " << quote(dir + "/clamp_forces.png") << "\nset title '" << name << ": clamp forces'\nset ylabel 'kN'\n"
-    << "plot " << csv << " using 1:15 with lines, '' using 1:16 with lines, '' using 1:25 with lines, '' using 1:26 with lines,"
-    << " '' using 1:35 with lines, '' using 1:36 with lines, '' using 1:45 with lines, '' using 1:46 with lines\n";
-  s << "set output " << quote(dir + "/mu_used.png") << "\nset title '" << name << ": mu used'\nset ylabel 'mu'\n"
-    << "plot " << csv << " using 1:13 with lines, '' using 1:23 with lines, '' using 1:33 with lines, '' using 1:43 with lines\n";
-  s << "set output " << quote(dir + "/path.png") << "\nset title '" << name << ": path'\nset xlabel 'x (m)'\nset ylabel 'y (m)'\n"
-    << "set size ratio -1\nplot " << csv << " using 4:5 with lines lw 2\n";
-  bbw::plot::run_gnuplot(s.str(), dir + "/vehicle_plots.gp");
-}
 
 }  // namespace
 
@@ -164,7 +143,7 @@ int main(int argc, char** argv) {
     bbw::vehicle_run::write_vehicle_json(w, m);
     w.end_object();
     w.save(out_dir + "/summary.json");
-    if (want_plots) plots(out_dir, scenario.name);
+    if (want_plots) bbw::vehicle_run::write_vehicle_plots(out_dir, scenario.name);
     std::printf("%s: stopping distance %.2f m (ideal %.2f m, ratio %.3f), epsilon %.3f, max lateral %.2f m, rtf %.1fx\n",
                 scenario.name.c_str(), m.stopping_distance_m, m.ideal_stopping_distance_m, m.distance_ratio,
                 m.adhesion_utilisation, m.max_lateral_deviation_m, scenario.corners.scenario.duration_s / wall_s);

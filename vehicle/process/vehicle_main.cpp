@@ -5,7 +5,7 @@
 // each corner's partition of the run), simulates the period and publishes VehicleSensors k in
 // the run's partition. At the end: OUT/vehicle_truth.csv and OUT/vehicle.json.
 //
-//   bbw_vehicle --scenario VEHICLE_SCENARIO.yaml --out DIR [--domain N] [--run-id HEX]
+//   bbw_vehicle --scenario VEHICLE_SCENARIO.yaml --out DIR [--no-plots] [--domain N] [--run-id HEX]
 //               [--discovery-timeout S] [--peer-timeout S] [--dds-profiles FILE.xml]
 //               [--dds-participant-profile NAME]
 //
@@ -136,7 +136,7 @@ class VehicleApp {
 };
 
 std::string usage() {
-  return runtime::process_usage("bbw_vehicle", "", {"--out DIR   (vehicle_truth.csv, vehicle.json)"});
+  return runtime::process_usage("bbw_vehicle", "", {"--out DIR [--no-plots]   (vehicle_truth.csv, vehicle.json, speeds/slips/clamp_forces/mu_used/path.png)"});
 }
 
 }  // namespace
@@ -149,11 +149,13 @@ int main(int argc, char** argv) {
   bbw::runtime::SignalWatcher signals([&](int) { events.interrupt(); });
   bbw::runtime::ProcessFlags flags;
   std::string out_dir;
+  bool plots = true;
   try {
     for (bbw::runtime::ArgCursor args(argc, argv); !args.done();) {
       const std::string k = args.flag();
       if (flags.take(k, args)) continue;
       if (k == "--out") out_dir = args.value();
+      else if (k == "--no-plots") plots = false;
       else if (k == "-h" || k == "--help") { std::cout << usage(); return 0; }
       else throw std::invalid_argument("unknown argument '" + k + "'");
     }
@@ -180,6 +182,7 @@ int main(int argc, char** argv) {
     rc = app.run(error);
     bbw::vehicle_run::write_truth_csv(out_dir + "/vehicle_truth.csv", app.node().truth());
     bbw::vehicle_run::write_vehicle_file(out_dir + "/vehicle.json", bbw::vehicle_run::vehicle_metrics(*scenario, app.node()));
+    if (plots) bbw::vehicle_run::write_vehicle_plots(out_dir, scenario->name);
     std::cout << "bbw_vehicle: " << app.periods_done() << " periods" << std::endl;
   } catch (const std::exception& e) {
     std::cerr << "bbw_vehicle: " << e.what() << "\n";

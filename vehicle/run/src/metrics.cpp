@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "bbw/common/plot.hpp"
 #include "bbw/vehicle/tyre.hpp"
 
 namespace bbw::vehicle_run {
@@ -170,6 +171,38 @@ void write_vehicle_file(const std::string& file, const VehicleMetrics& m) {
   write_vehicle_json(w, m);
   w.end_object();
   w.save(file);
+}
+
+void write_vehicle_plots(const std::string& dir, const std::string& title) {
+  using plot::quote;
+  const std::string csv = quote(dir + "/vehicle_truth.csv");
+  // Columns: 1 time, 2 speed, 3 x, 4 y; per wheel w (0 FL .. 3 RR) from 11 + 7 w: wheel speed,
+  // slip, mu used, clamp force, brake torque, disc, caliper.
+  auto col = [](int w, int k) { return std::to_string(11 + 7 * w + k); };
+  static const char* names[4] = {"FL", "FR", "RL", "RR"};
+  // The four wheels' column k; the first names the file unless `more` (a plot that began already).
+  auto per_wheel = [&](int k, bool more = false) {
+    std::string s;
+    for (int w = 0; w < 4; ++w) {
+      const bool first = w == 0 && !more;
+      s += std::string(first ? "" : ", ") + (first ? csv : std::string("''")) + " using 1:" + col(w, k) +
+           " with lines title '" + names[w] + "'";
+    }
+    return s;
+  };
+  std::string g = "set terminal pngcairo noenhanced size 1000,600\nset datafile separator ','\nset grid\nset key outside right\n"
+                  "set xlabel 'time (s)'\n";
+  g += "set output " + quote(dir + "/speeds.png") + "\nset title '" + title + ": vehicle and wheel speeds'\nset ylabel 'm/s'\n";
+  g += "plot " + csv + " using 1:2 with lines lw 2 title 'vehicle'" + per_wheel(0, true) + "\n";
+  g += "set output " + quote(dir + "/slips.png") + "\nset title '" + title + ": longitudinal slip'\nset ylabel 'slip'\n";
+  g += "plot " + per_wheel(1) + "\n";
+  g += "set output " + quote(dir + "/clamp_forces.png") + "\nset title '" + title + ": true clamp forces'\nset ylabel 'kN'\n";
+  g += "plot " + per_wheel(3) + "\n";
+  g += "set output " + quote(dir + "/mu_used.png") + "\nset title '" + title + ": mu used |F| / Fz'\nset ylabel 'mu'\n";
+  g += "plot " + per_wheel(2) + "\n";
+  g += "set output " + quote(dir + "/path.png") + "\nset title '" + title + ": path (y scale enlarged)'\nset xlabel 'x (m)'\nset ylabel 'y (m)'\n"
+       "plot " + csv + " using 3:4 with lines lw 2 title 'CG'\n";
+  plot::run_gnuplot(g, dir + "/vehicle_plots.gp");
 }
 
 }  // namespace bbw::vehicle_run

@@ -42,6 +42,10 @@ void write_vehicle_json(json::Writer& w, const VehicleMetrics& m);
 // JSON document {"vehicle": {...}} (vehicle.json, merged into summary.json by bbw_launch).
 void write_truth_csv(const std::string& file, const std::vector<TruthRow>& truth);
 void write_vehicle_file(const std::string& file, const VehicleMetrics& m);
+// The run's plots from DIR/vehicle_truth.csv through gnuplot: DIR/speeds.png (vehicle and wheel
+// speeds), slips.png, clamp_forces.png (true), mu_used.png, path.png (x-y). Throws
+// std::runtime_error when gnuplot fails (bbw/common/plot.hpp).
+void write_vehicle_plots(const std::string& dir, const std::string& title);
 // The tyre model's peak adhesion for a straight stop on `surface` (deceleration z at which every
 // wheel is at its peak at its dynamic load), and the per-axle adhesion k at deceleration z.
 double peak_adhesion(const vehicle::VehicleParams& p, const vehicle::Surface& surface);
