@@ -1,5 +1,5 @@
 // bbw_vehicle_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--monitor FILE]
-//                    [--feedback load_cell|curve|compensated] [--exchange-every N] [--no-plots]
+//                    [--feedback load_cell|eol_curve|compensated] [--exchange-every N] [--no-plots]
 // A vehicle scenario (config/scenarios/vehicle/) in one process, lockstep over the in-memory
 // transport: the CCU (with its brake functions) and the four corners of InProcessRun, the vehicle
 // and the pedal as further participants of its barrier. Writes DIR/summary.json (the `vehicle`
@@ -29,7 +29,7 @@ namespace {
 int usage(const std::string& why) {
   std::cerr << "bbw_vehicle_inproc: " << why << "\n"
             << "usage: bbw_vehicle_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--monitor FILE] "
-               "[--feedback load_cell|curve|compensated] [--exchange-every N] [--no-plots]\n";
+               "[--feedback load_cell|eol_curve|compensated] [--exchange-every N] [--no-plots]\n";
   return 2;
 }
 
@@ -86,8 +86,8 @@ int main(int argc, char** argv) {
   if (scenario_file.empty()) return usage("a scenario file is required");
   if (out_dir.empty()) return usage("--out DIR is required");
   if (exchange_every < 1 || exchange_every > 64) return usage("--exchange-every must be in [1, 64]");
-  if (!feedback.empty() && feedback != "load_cell" && feedback != "curve" && feedback != "compensated") {
-    return usage("--feedback must be load_cell, curve or compensated, got '" + feedback + "'");
+  if (!feedback.empty() && feedback != "load_cell" && feedback != "eol_curve" && feedback != "compensated") {
+    return usage("--feedback must be load_cell, eol_curve or compensated, got '" + feedback + "'");
   }
   bbw::vehicle_run::VehicleScenario scenario;
   bbw::calibration::CalibratorConfig calibrator;
@@ -99,12 +99,16 @@ int main(int argc, char** argv) {
     calibrator = bbw::calibration::load_config(calibrator_file);
     calibrator.validate();
     options.in_process.monitor = bbw::faults::load_monitor_params(monitor_file);
+    // The calibration study (docs/vehicle.md): (a) load_cell: the raw load cell; (b) eol_curve:
+    // the end-of-line curve (the calibrator's initial curve) at the measured position;
+    // (c)/(d) compensated: the load cell less the friction the CCU's calibrator (--calibrator)
+    // identifies.
     if (!feedback.empty()) {
-      const auto f = feedback == "load_cell" ? bbw::corner_unit::ForceFeedback::LoadCell
-                     : feedback == "curve"   ? bbw::corner_unit::ForceFeedback::Curve
-                                             : bbw::corner_unit::ForceFeedback::Compensated;
+      const auto f = feedback == "compensated" ? bbw::corner_unit::ForceFeedback::Compensated
+                                               : bbw::corner_unit::ForceFeedback::LoadCell;
       for (auto& c : scenario.corners.scenario.corners) c.drive.feedback = f;
       options.in_process.friction_feedback = feedback == "compensated";
+      if (feedback == "eol_curve") options.curve_feedback = calibrator.initial_curve;
     }
     options.exchange_every_samples = exchange_every;
     options.in_process.process_faults = true;  // a corner kill in a vehicle scenario is carried out in process
@@ -141,6 +145,18 @@ int main(int argc, char** argv) {
     for (const auto& p : scenario.processes) w.value("", p);
     w.end_array();
     bbw::vehicle_run::write_vehicle_json(w, m);
+    {
+      const auto err = bbw::vehicle_run::clamp_force_error(run);
+      w.begin_object("clamp_force_error");  // (F_true - F_cmd) / F_cmd, mean over the stop
+      const char* names[4] = {"FL", "FR", "RL", "RR"};
+      for (std::size_t i = 0; i < 4; ++i) w.value(names[i], err[i]);
+      w.end_object();
+      w.begin_object("fits_accepted");  // the CCU's calibrator per corner
+      for (std::size_t i = 0; i < 4; ++i) {
+        w.value(names[i], static_cast<long long>(run.in_process().ccu().core().supervisor(i).calibrator().stats().fits_accepted));
+      }
+      w.end_object();
+    }
     w.end_object();
     w.save(out_dir + "/summary.json");
     if (want_plots) bbw::vehicle_run::write_vehicle_plots(out_dir, scenario.name);

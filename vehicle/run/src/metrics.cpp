@@ -102,6 +102,18 @@ VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleNode& run)
     }
   }
   for (std::size_t w = 0; w < 4; ++w) m.slip_rms[w] = count ? std::sqrt(sum[w] / count) : 0.0;
+  double bal = 0.0;
+  std::size_t nbal = 0;
+  for (const TruthRow& t : tr) {
+    if (t.time_s < run.brake_onset_s() || run.brake_onset_s() < 0.0 || t.stopped) continue;
+    m.max_steer_deg = std::max(m.max_steer_deg, std::abs(t.steer_rad) * 180.0 / M_PI);
+    const double fl = t.clamp_true_kN[0], fr = t.clamp_true_kN[1];
+    if (t.speed_m_s > 15.0 / 3.6 && fl > 1.0 && fr > 1.0) {
+      bal += (fl - fr) / (0.5 * (fl + fr));
+      ++nbal;
+    }
+  }
+  m.front_balance_error = nbal ? bal / static_cast<double>(nbal) : std::numeric_limits<double>::quiet_NaN();
   m.mean_deceleration_g = m.stopped ? m.onset_speed_m_s / m.stopping_time_s / kG : std::numeric_limits<double>::quiet_NaN();
   return m;
 }
@@ -131,7 +143,24 @@ void write_vehicle_json(json::Writer& w, const VehicleMetrics& m) {
   w.value("max_yaw_rate_deg_s", m.max_yaw_rate_deg_s);
   w.value("max_lateral_deviation_m", m.max_lateral_deviation_m);
   w.value("mean_deceleration_g", m.mean_deceleration_g);
+  w.value("front_balance_error", m.front_balance_error);
+  w.value("max_steer_deg", m.max_steer_deg);
   w.end_object();
+}
+
+std::array<double, 4> clamp_force_error(const VehicleRun& run) {
+  std::array<double, 4> sum{}, n{};
+  for (const PeriodTrace& t : run.trace()) {
+    if (t.time_s < run.brake_onset_s() || run.brake_onset_s() < 0.0 || t.stopped || t.speed_m_s < 15.0 / 3.6) continue;
+    for (std::size_t w = 0; w < 4; ++w) {
+      if (t.command_kN[w] <= 1.0) continue;
+      sum[w] += (t.clamp_true_kN[w] - t.command_kN[w]) / t.command_kN[w];
+      n[w] += 1.0;
+    }
+  }
+  std::array<double, 4> out{};
+  for (std::size_t w = 0; w < 4; ++w) out[w] = n[w] > 0 ? sum[w] / n[w] : std::numeric_limits<double>::quiet_NaN();
+  return out;
 }
 
 void write_truth_csv(const std::string& file, const std::vector<TruthRow>& truth) {

@@ -51,6 +51,11 @@ const msg::VehicleSensors& VehicleNode::simulate_period(std::uint64_t k, std::si
       if (every_ == 1 || global % static_cast<std::uint64_t>(every_) == 0) in_.clamp_force_kN[w] = force_[w][j];
     }
     const vehicle::VehicleState& st = vehicle_.state();
+    const bool cruising = st.time_s < scenario_.cruise_until_s;
+    if (scenario_.cruise_until_s > 0.0) {
+      const double t = cruising ? std::max(0.0, scenario_.cruise_gain_Nm_per_m_s * (scenario_.initial_speed_m_s - vehicle_.speed_m_s())) : 0.0;
+      in_.drive_torque_Nm[2] = in_.drive_torque_Nm[3] = t;
+    }
     if (driver_) in_.steer_rad = driver_->steer(dt_s_, st.x_m, st.y_m, st.yaw_rad, vehicle_.speed_m_s(), st.yaw_rate_rad_s);
     vehicle_.step(dt_s_, in_);
     const vehicle::VehicleState& s = vehicle_.state();
@@ -60,7 +65,7 @@ const msg::VehicleSensors& VehicleNode::simulate_period(std::uint64_t k, std::si
     ay += imu.ay_m_s2 / static_cast<double>(n);
     r += imu.yaw_rate_rad_s / static_cast<double>(n);
     const double v = vehicle_.speed_m_s();
-    if (onset_s_ < 0.0 && pedal_profile_.travel_fraction(s.time_s) > 0.0) {
+    if (onset_s_ < 0.0 && s.time_s >= scenario_.cruise_until_s && pedal_profile_.travel_fraction(s.time_s) > 0.0) {
       onset_s_ = s.time_s;
       onset_speed_m_s_ = v;
       onset_path_m_ = s.path_m;

@@ -23,6 +23,7 @@ VehicleRun::VehicleRun(const VehicleScenario& s, const calibration::CalibratorCo
   vehicle_participant_ = run_.ccu().add_participant("vehicle");
   pedal_participant_ = run_.ccu().add_participant("pedal");
   run_.set_period_hook([this](std::uint64_t k) { vehicle_period(k); });
+  run_.ccu().set_curve_feedback(options.curve_feedback);
   trace_.reserve(static_cast<std::size_t>(run_.ccu().periods()) + 2);
 }
 

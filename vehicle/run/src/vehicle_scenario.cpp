@@ -108,6 +108,11 @@ VehicleScenario load_vehicle_scenario(const std::string& file) {
       d->fail("", e.what());
     }
   }
+  if (auto c = r.optional_map("cruise")) {
+    s.cruise_until_s = c->number("until_s", Range::closed(0, s.corners.scenario.duration_s));
+    s.cruise_gain_Nm_per_m_s = c->number("gain_Nm_per_m_s", Range::closed(0, 1e5));
+    c->finish();
+  }
   {
     const std::vector<double> disc = r.numbers("disc_temperature_C", Range::closed(-40, 800));
     if (disc.size() != 4) r.fail("disc_temperature_C", "four values: FL, FR, RL, RR");

@@ -73,6 +73,10 @@ class CcuCore {
   // force instead of the scenario's pedal profile. A slot with a value is commanded that force
   // in plan() when it is available; nullopt (the default) leaves plan() as it was.
   void set_brake_commands(const std::array<std::optional<double>, kSlots>& clamp_force_kN) { brake_commands_ = clamp_force_kN; }
+  // A study of what calibration is worth (issue 15, docs/vehicle.md): every available corner is
+  // told to close its loop on `curve` (FEEDBACK_CURVE), e.g. the end-of-line curve, whatever the
+  // calibrator learns. nullopt (the default): plan() as it was.
+  void set_curve_feedback(const std::optional<calibration::Curve>& curve) { curve_feedback_ = curve; }
 
   const faults::CornerSupervisor& supervisor(std::size_t slot) const { return *supervisors_[slot]; }
 
@@ -85,6 +89,7 @@ class CcuCore {
   std::optional<faults::Redistributor> redistributor_;
   std::array<CornerPlan, kSlots> plans_{};
   std::array<std::optional<double>, kSlots> brake_commands_{};
+  std::optional<calibration::Curve> curve_feedback_;
   SampleOutcome outcome_;
 };
 

@@ -123,6 +123,7 @@ class CcuNode {
   void set_brake_commands(const std::array<std::optional<double>, ccu::kSlots>& clamp_force_kN) {
     core_.set_brake_commands(clamp_force_kN);
   }
+  void set_curve_feedback(const std::optional<calibration::Curve>& curve) { core_.set_curve_feedback(curve); }
   // Further lockstep participants (the vehicle, the pedal): each reports the periods it finished;
   // one whose writer is gone no longer holds the barrier.
   std::size_t add_participant(const std::string& name) { return barrier_.add(name); }

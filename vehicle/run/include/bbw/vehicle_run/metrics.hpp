@@ -32,7 +32,15 @@ struct VehicleMetrics {
   double max_yaw_rate_deg_s = 0.0;
   double max_lateral_deviation_m = 0.0;   // from the driver's path (straight: |y|)
   double mean_deceleration_g = 0.0;       // onset speed / stopping time / g
+  // During the stop above 15 km/h with both front calipers above 1 kN: the mean of
+  // (F_FL - F_FR) / mean(F_FL, F_FR) of the true clamp forces (brake balance across the axle).
+  double front_balance_error = 0.0;
+  double max_steer_deg = 0.0;             // the driver's largest road-wheel angle during the stop
 };
+
+// The CCU's commands against the calipers' true forces (in process: the trace holds both): per
+// corner the mean of (F_true - F_cmd) / F_cmd during the stop above 15 km/h where F_cmd > 1 kN.
+std::array<double, 4> clamp_force_error(const VehicleRun& run);
 
 VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleNode& vehicle);
 inline VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleRun& run) { return vehicle_metrics(s, run.vehicle_node()); }

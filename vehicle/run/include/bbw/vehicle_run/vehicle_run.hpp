@@ -55,6 +55,9 @@ struct VehicleRunOptions {
   // vehicle (the shipped partition); n > 1 = the vehicle sees only every n-th sample held in
   // between (coarser exchange, for the partition study).
   int exchange_every_samples = 1;
+  // The calibration study: every corner closes its loop on this curve (e.g. the end-of-line
+  // curve, CalibratorConfig::initial_curve) instead of its own feedback.
+  std::optional<calibration::Curve> curve_feedback;
 };
 
 class VehicleRun {

@@ -31,6 +31,12 @@ struct VehicleScenario {
   std::array<double, 4> disc_C{};
   std::array<double, 4> caliper_C{};    // from the corners' temperature_C
   std::vector<std::string> processes;   // declared process list: ccu, FL, FR, RL, RR, vehicle, pedal
+  // Optional calibration phase: until cruise_until_s the engine holds the start speed (a drive
+  // torque on the rear wheels, gain_Nm_per_m_s per wheel on the speed error) while the driver
+  // modulates the brake, so the CCU's calibrator sees hysteresis cycles before the stop. The stop
+  // (its onset, distance, ideal) begins at the first pedal travel after it. 0: none.
+  double cruise_until_s = 0.0;
+  double cruise_gain_Nm_per_m_s = 3000.0;
 };
 
 VehicleScenario load_vehicle_scenario(const std::string& file);  // throws config::ConfigError
