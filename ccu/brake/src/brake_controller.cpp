@@ -121,12 +121,17 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
   // Yaw-moment limitation: split-mu is seen when one front wheel is under slip control with a
   // torque well below the other's; the high side may then exceed the low side only by a torque
   // that grows at a limited rate (the driver has time to counter-steer). Rear: select-low.
+  // A corner the CCU cannot use (lost, failed) brakes nothing: count it as the low side, so the
+  // yaw-moment limitation also acts on the asymmetry a lost front corner leaves.
+  for (std::size_t w = 0; w < 4; ++w) {
+    if (!m.available[w]) out_.torque_Nm[w] = 0.0;
+  }
   if (p_.abs_enabled && p_.yaw.enabled) {
     const double lo = std::min(out_.torque_Nm[0], out_.torque_Nm[1]);
     const double hi = std::max(out_.torque_Nm[0], out_.torque_Nm[1]);
     const std::size_t low_side = out_.torque_Nm[0] <= out_.torque_Nm[1] ? 0 : 1;
-    const bool asym = out_.wheels[low_side].active && hi > 0.0 && lo < p_.yaw.asymmetry_ratio * hi &&
-                      hi - lo > p_.yaw.min_difference_Nm;
+    const bool asym = (out_.wheels[low_side].active || !m.available[low_side]) && hi > 0.0 &&
+                      lo < p_.yaw.asymmetry_ratio * hi && hi - lo > p_.yaw.min_difference_Nm;
     if (asym && !split_) {
       split_ = true;
       split_s_ = 0.0;
