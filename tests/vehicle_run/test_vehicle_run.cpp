@@ -59,6 +59,36 @@ TEST(VehicleScenario, UnknownSurfaceNamesFileLineAndKey) {
   std::filesystem::remove(file);
 }
 
+TEST(VehicleScenario, TheProcessListIsCheckedWithItsLine) {
+  std::ifstream in(scen("dry_straight_100kmh"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const std::string key : {"corners: ", "vehicle: ", "brake_control: "}) {
+    const auto p = text.find("\n" + key) + 1;
+    text.insert(p + key.size(), src() + "/config/scenarios/vehicle/");
+  }
+  const std::string file = (std::filesystem::temp_directory_path() / "bbw_vehicle_processes.yaml").string();
+  auto expect_error = [&](const std::string& body, const std::string& what) {
+    std::ofstream(file) << body;
+    try {
+      vehicle_run::load_vehicle_scenario(file);
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const config::ConfigError& e) {
+      EXPECT_EQ(e.key_path(), "processes") << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  std::string t = text;
+  t.replace(t.find("processes: [ccu, FL, FR, RL, RR, vehicle, pedal]"), 48, "processes: [ccu, FL, FR, RL, RR, vehicle, pedal, radar]");
+  expect_error(t, "unknown process 'radar'");
+  t = text;
+  t.replace(t.find("processes: [ccu, FL, FR, RL, RR, vehicle, pedal]"), 48, "processes: [ccu, FL, FR, RL, RR, vehicle]");
+  expect_error(t, "runs pedal too");
+  t = text;
+  t.replace(t.find("processes: [ccu, FL, FR, RL, RR, vehicle, pedal]"), 48, "processes: ccu");
+  expect_error(t, "must be a list of strings");
+  std::filesystem::remove(file);
+}
+
 TEST(VehicleRun, DryStopIsDeterministicLockstepAndStops) {
   const auto s = vehicle_run::load_vehicle_scenario(scen("dry_straight_100kmh"));
   const auto cal = calibrator();
