@@ -139,7 +139,8 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
     if (split_) {
       split_s_ += dt_s;
       // Braking the right (left) side more turns the car right (left), yaw rate negative (positive).
-      const double yaw_error = m.yaw_rate_rad_s - (v > 1.0 ? m.ay_m_s2 / v : 0.0);
+      const double driver_yaw_rate = v * m.steer_rad / (L + c.understeer_gradient_rad_s2_per_m * v * v);
+      const double yaw_error = m.yaw_rate_rad_s - driver_yaw_rate;
       const double towards_high = low_side == 0 ? -yaw_error : yaw_error;  // > 0: yawing towards the high side
       const double allowed = std::max(lo, lo + p_.yaw.initial_Nm + p_.yaw.ramp_Nm_per_s * split_s_ -
                                               p_.yaw.yaw_error_gain_Nm_per_rad_s * std::max(0.0, towards_high));

@@ -24,6 +24,7 @@ BrakeControlParams read_brake_control(Reader& r) {
     p.car.front_effective_radius_m = c.number("front_effective_radius_m", Range::closed(0.03, 0.3));
     p.car.rear_effective_radius_m = c.number("rear_effective_radius_m", Range::closed(0.03, 0.3));
     p.car.max_clamp_force_kN = c.number("max_clamp_force_kN", Range::closed(1, 100));
+    p.car.understeer_gradient_rad_s2_per_m = c.number("understeer_gradient_rad_s2_per_m", Range::closed(-0.01, 0.01));
     c.finish();
   }
   {

@@ -93,6 +93,9 @@ const msg::VehicleSensors& VehicleNode::simulate_period(std::uint64_t k, std::si
   sensors_.ax_m_s2(ax);
   sensors_.ay_m_s2(ay);
   sensors_.yaw_rate_rad_s(r);
+  // The steering-angle sensor: 0.1 deg at the hand wheel (ratio 15) as road-wheel resolution.
+  constexpr double kSteerResolution_rad = 0.1 / 15.0 * M_PI / 180.0;
+  sensors_.steering_angle_rad(std::round(in_.steer_rad / kSteerResolution_rad) * kSteerResolution_rad);
   sensors_.speed_true_m_s(vehicle_.speed_m_s());
   sensors_.x_true_m(s.x_m);
   sensors_.y_true_m(s.y_m);
@@ -147,6 +150,7 @@ void BrakeFunctions::on_vehicle(const msg::VehicleSensors& s) {
   meas_.ax_m_s2 = s.ax_m_s2();
   meas_.ay_m_s2 = s.ay_m_s2();
   meas_.yaw_rate_rad_s = s.yaw_rate_rad_s();
+  meas_.steer_rad = s.steering_angle_rad();
 }
 
 void BrakeFunctions::on_pedal(const msg::PedalSample& p) {

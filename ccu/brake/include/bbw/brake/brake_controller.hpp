@@ -21,6 +21,7 @@ struct BrakeMeasurements {
   double ax_m_s2 = 0.0;                     // IMU
   double ay_m_s2 = 0.0;
   double yaw_rate_rad_s = 0.0;
+  double steer_rad = 0.0;                   // steering-angle sensor (road wheel, left positive)
   double pedal_travel_mm = 0.0;             // pedal sensor 1
   double pedal_force_N = 0.0;               // pedal sensor 2
   std::array<double, 4> clamp_estimate_kN{};  // the CCU's clamp-force estimate per corner

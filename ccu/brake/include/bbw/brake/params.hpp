@@ -18,6 +18,9 @@ struct CarModel {
   double front_effective_radius_m = 0.12;
   double rear_effective_radius_m = 0.10;
   double max_clamp_force_kN = 40.0;
+  // Understeer gradient of the linear single-track model (rad per m/s^2 of lateral acceleration):
+  // the driver's yaw rate is v delta / (L + K_us v^2).
+  double understeer_gradient_rad_s2_per_m = 1.6e-4;
 };
 
 struct PedalDemandParams {
@@ -61,8 +64,9 @@ struct YawLimitParams {
   double min_difference_Nm = 300.0;     // ... and more than this apart (noise on low mu is no split)
   double ramp_Nm_per_s = 1000.0;        // how fast the high side may exceed the low side
   double initial_Nm = 200.0;
-  // Yaw-rate feedback (from measurements only): the yaw rate beyond the one the lateral
-  // acceleration explains (r - a_y / v, the sideslip's growth) takes torque off the high side.
+  // Yaw-rate feedback (from measurements only): the measured yaw rate beyond the one the driver
+  // steers for (the steering-angle sensor through the single-track model) takes torque off the
+  // high side.
   double yaw_error_gain_Nm_per_rad_s = 8000.0;
   bool rear_select_low = true;
 };
