@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "bbw/calibration/config_yaml.hpp"
+#include "bbw/vehicle/tyre.hpp"
 #include "bbw/vehicle_run/metrics.hpp"
 #include "bbw/vehicle_run/vehicle_run.hpp"
 
@@ -140,4 +141,25 @@ TEST(VehicleRun, TheCaliperTemperatureComesFromTheDriving) {
   const double vehicle_C = r.vehicle().state().wheels[0].caliper_C;
   EXPECT_GT(vehicle_C, s.caliper_C[0] + 2.0);
   EXPECT_NEAR(sensed, vehicle_C, 0.5);  // the plant's temperature sensor reads the vehicle's caliper
+}
+
+// UN R13-H Annex 6 Appendix 2's per-axle adhesion from simulated runs without anti-lock: a
+// constant clamp force cannot hold the tyre at its peak all the way from 40 to 20 km/h, so each
+// axle's coefficient is below the tyre model's peak at the axle's load, but not far below it.
+TEST(Regulation, AxleAdhesionFromRunsWithoutAntiLockIsJustBelowTheTyresPeak) {
+  const auto s = vehicle_run::load_vehicle_scenario(scen("dry_straight_100kmh"));
+  const vehicle::VehicleParams& p = s.vehicle.vehicle;
+  const vehicle_run::AxleAdhesion k = vehicle_run::axle_adhesion(p, s.road);
+  const vehicle::Surface& road = s.road.surface_at(0.0, 0.0);
+  const vehicle::ChassisParams& c = p.chassis;
+  const double W = c.mass_kg * 9.81, E = c.wheelbase_m();
+  // The braked axle's dynamic load at the rate measured, and the tyre's peak at half of it.
+  const double front_N = W * c.cg_to_rear_axle_m / E + c.cg_height_m / E * k.z_front * W;
+  const double rear_N = W * c.cg_to_front_axle_m / E - c.cg_height_m / E * k.z_rear * W;
+  const double mu_f = vehicle::peak_longitudinal_mu(p.tyre, 0.5 * front_N, road.mu_scale, road.stiffness_scale).mu;
+  const double mu_r = vehicle::peak_longitudinal_mu(p.tyre, 0.5 * rear_N, road.mu_scale, road.stiffness_scale).mu;
+  EXPECT_LT(k.front, mu_f);
+  EXPECT_GT(k.front, 0.85 * mu_f);
+  EXPECT_LT(k.rear, mu_r);
+  EXPECT_GT(k.rear, 0.85 * mu_r);
 }

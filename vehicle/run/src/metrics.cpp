@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <stdexcept>
+#include <vector>
 
 #include "bbw/common/plot.hpp"
 #include "bbw/vehicle/tyre.hpp"
@@ -27,6 +28,91 @@ double axle_mu(const vehicle::VehicleParams& p, const vehicle::Surface& s, doubl
   return vehicle::peak_longitudinal_mu(p.tyre, 0.5 * axle_N, s.mu_scale, s.stiffness_scale).mu;
 }
 }  // namespace
+
+namespace {
+
+// One run of UN R13-H Annex 6 Appendix 2, 1.1: from 50 km/h, a constant clamp force on one axle's
+// brakes only (the plant alone, no anti-lock, no e-caliper dynamics); the time from 40 to 20 km/h,
+// and whether a braked wheel locked (below half the vehicle speed) above 20 km/h.
+struct AxleRun {
+  double t_s = 0.0;
+  bool locked = false;
+  bool valid = false;
+};
+AxleRun axle_run(const vehicle::VehicleParams& p, const vehicle::RoadParams& road, bool front, double clamp_kN) {
+  vehicle::Vehicle v(p, road);
+  v.reset(50.0 / 3.6, {40, 40, 40, 40}, {28, 28, 28, 28});
+  vehicle::VehicleInputs in;
+  const std::size_t a = front ? 0 : 2;
+  in.clamp_force_kN[a] = in.clamp_force_kN[a + 1] = clamp_kN;
+  AxleRun r;
+  double t40 = -1.0;
+  double prev_v = v.speed_m_s(), prev_t = 0.0;
+  while (v.state().time_s < 30.0 && !v.state().stopped) {
+    v.step(0.001, in);
+    const double speed = v.speed_m_s(), t = v.state().time_s;
+    if (speed > 20.0 / 3.6) {
+      for (std::size_t w = a; w < a + 2; ++w) {
+        if (v.state().wheels[w].spin_rad_s * p.chassis.wheel_radius_m < 0.5 * speed) r.locked = true;
+      }
+    }
+    auto cross = [&](double kmh) {
+      const double x = kmh / 3.6;
+      return prev_v > x && speed <= x ? prev_t + (prev_v - x) / (prev_v - speed) * (t - prev_t) : -1.0;
+    };
+    if (t40 < 0.0) t40 = cross(40.0);
+    const double t20 = cross(20.0);
+    if (t40 >= 0.0 && t20 >= 0.0) {
+      r.t_s = t20 - t40;
+      r.valid = true;
+      break;
+    }
+    prev_v = speed;
+    prev_t = t;
+  }
+  return r;
+}
+
+}  // namespace
+
+AxleAdhesion axle_adhesion(const vehicle::VehicleParams& p, const vehicle::RoadParams& road) {
+  const vehicle::ChassisParams& c = p.chassis;
+  const double P = c.mass_kg, E = c.wheelbase_m(), h = c.cg_height_m;
+  const double Ff = P * kG * c.cg_to_rear_axle_m / E, Fr = P * kG * c.cg_to_front_axle_m / E;
+  AxleAdhesion out;
+  for (const bool front : {true, false}) {
+    // Increments of the input force; the shortest times without lock (1.1.3).
+    std::vector<double> times;
+    for (double f = 0.25; f <= p.brake(front ? 0 : 2).max_clamp_force_kN + 1e-9; f += 0.25) {
+      const AxleRun r = axle_run(p, road, front, f);
+      if (r.valid && !r.locked) times.push_back(r.t_s);
+    }
+    if (times.empty()) {
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      return {nan, nan, nan, nan};
+    }
+    std::sort(times.begin(), times.end());
+    // 1.1.3.2: the mean of three times within t_min and 1.05 t_min (t_min alone if fewer).
+    double sum = 0.0;
+    int n = 0;
+    for (double t : times) {
+      if (t > 1.05 * times.front() || n == 3) break;
+      sum += t;
+      ++n;
+    }
+    const double z = 0.566 / (n == 3 ? sum / 3.0 : times.front());
+    // 1.1.4-1.1.5: the rolling resistance of the unbraked axle (0.015 driven, the rear here;
+    // 0.010 not driven) and the braked axle's dynamic load.
+    if (front) {
+      out.front = (z * P * kG - 0.015 * Fr) / (Ff + h / E * z * P * kG);
+      out.z_front = z;
+    } else {
+      out.rear = (z * P * kG - 0.010 * Ff) / (Fr - h / E * z * P * kG);
+      out.z_rear = z;
+    }
+  }
+  return out;
+}
 
 double peak_adhesion(const vehicle::VehicleParams& p, const vehicle::Surface& surface) {
   double z = axle_mu(p, surface, 0.5 * p.chassis.mass_kg * kG);
@@ -71,18 +157,9 @@ VehicleMetrics vehicle_metrics(const VehicleScenario& s, const VehicleNode& run)
   if (uniform && t45 >= 0.0 && t15 > t45) {
     m.z_AL = 0.849 / (t15 - t45);
     const AxleLoads dyn = axle_loads(p.chassis, m.z_AL);
-    // Per-axle adhesion: each axle braked alone at its peak (the regulation's k_f, k_r).
-    auto axle_alone = [&](bool front) {
-      double z = 0.5;
-      for (int i = 0; i < 50; ++i) {
-        const AxleLoads a = axle_loads(p.chassis, front ? z : -z);
-        const double axle = front ? a.front_N : a.rear_N;
-        z = axle_mu(p, start_surface, axle) * axle / (p.chassis.mass_kg * kG);
-      }
-      const AxleLoads a = axle_loads(p.chassis, front ? z : -z);
-      return axle_mu(p, start_surface, front ? a.front_N : a.rear_N);
-    };
-    const double k_f = axle_alone(true), k_r = axle_alone(false);
+    // k_f, k_r the regulation's way: braking runs with one axle braked, no anti-lock.
+    const AxleAdhesion k = axle_adhesion(p, s.road);
+    const double k_f = k.front, k_r = k.rear;
     m.k_M = (k_f * dyn.front_N + k_r * dyn.rear_N) / (p.chassis.mass_kg * kG);
     m.adhesion_utilisation = m.z_AL / m.k_M;
   } else {

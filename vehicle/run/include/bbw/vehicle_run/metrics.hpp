@@ -19,10 +19,10 @@ struct VehicleMetrics {
   double mu_peak = 0.0;                   // the tyre model's peak at the start surface, with load transfer
   double ideal_stopping_distance_m = 0.0; // v^2 / (2 mu_peak g)
   double distance_ratio = 0.0;
-  // UN R13-H Annex 6 Appendix 2: z_AL = 0.849 / t(45 -> 15 km/h) measured in this run; k_M from the
-  // tyre model's per-axle adhesion at the axles' dynamic loads (the regulation's per-axle runs
-  // without anti-lock are not simulated); epsilon = z_AL / k_M. NaN when the run did not pass
-  // 45 and 15 km/h.
+  // UN R13-H Annex 6 Appendix 2: z_AL = 0.849 / t(45 -> 15 km/h) measured in this run (which starts
+  // at its own speed, not 55 km/h); k_M = (k_f F_f,dyn + k_r F_r,dyn) / (P g) with k_f, k_r from
+  // simulated braking runs per axle without anti-lock (axle_adhesion); epsilon = z_AL / k_M. NaN
+  // when the run did not pass 45 and 15 km/h or the road is not uniform.
   double z_AL = 0.0;
   double k_M = 0.0;
   double adhesion_utilisation = 0.0;
@@ -57,5 +57,17 @@ void write_vehicle_plots(const std::string& dir, const std::string& title);
 // The tyre model's peak adhesion for a straight stop on `surface` (deceleration z at which every
 // wheel is at its peak at its dynamic load), and the per-axle adhesion k at deceleration z.
 double peak_adhesion(const vehicle::VehicleParams& p, const vehicle::Surface& surface);
+// The regulation's adhesion coefficients of the front and the rear axle (Annex 6 Appendix 2,
+// 1.1): runs from 50 km/h with one axle braked at a constant clamp force in 0.25 kN increments
+// (the plant alone: no anti-lock, no e-caliper dynamics), z = 0.566 / t(40 -> 20 km/h) from the
+// mean of the three shortest times without wheel lock within 1.05 t_min, less the unbraked axle's
+// rolling resistance (0.015 driven, 0.010 not), over the braked axle's dynamic load.
+struct AxleAdhesion {
+  double front = 0.0;     // k_f
+  double rear = 0.0;      // k_r
+  double z_front = 0.0;   // the braking rates they come from
+  double z_rear = 0.0;
+};
+AxleAdhesion axle_adhesion(const vehicle::VehicleParams& p, const vehicle::RoadParams& road);
 
 }  // namespace bbw::vehicle_run
