@@ -125,7 +125,13 @@ bool CcuApp::wait_for_corners(std::string& error) {
     bool all = calibration_.peers() >= n;
     for (const auto& c : commands_) all = all && c->peers() >= 1;
     for (std::size_t i = 0; i < node_.channels(); ++i) all = all && node_.channel(i).health >= 0 && blocks_[i]->peers() >= 1;
-    if (brake_) all = all && vehicle_in_->peers() >= 1 && pedal_in_->peers() >= 1;
+    if (brake_) {
+      all = all && vehicle_in_->peers() >= 1 && pedal_in_->peers() >= 1;
+      // The pedal reads the front-left corner's commands (its grants).
+      for (std::size_t i = 0; i < node_.channels(); ++i) {
+        if (node_.channel(i).slot == 0) all = all && commands_[i]->peers() >= 2;
+      }
+    }
     return all;
   });
   if (!ok && !events_.interrupted()) {

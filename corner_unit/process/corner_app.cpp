@@ -86,8 +86,11 @@ void CornerApp::publish_health(std::uint8_t status) { health_.send(node_.health(
 bool CornerApp::wait_for_ccu(std::string& error) {
   const auto timeout = options_.match_timeout.count() > 0 ? options_.match_timeout : options_.discovery_timeout;
   const bool ok = events_.wait_for(timeout, [&] {
-    return blocks_.peers() >= 1 && commands_.peers() >= 1 && calibration_.peers() >= 1 && health_.peers() >= 1 &&
-           (vehicle_in_ == nullptr || vehicle_in_->peers() >= 1);
+    // A vehicle run: the vehicle reads our blocks too (its reader must have matched before block 0,
+    // which is not sent again), and we read its sensors.
+    const int block_readers = vehicle_in_ == nullptr ? 1 : 2;
+    return blocks_.peers() >= block_readers && commands_.peers() >= 1 && calibration_.peers() >= 1 &&
+           health_.peers() >= 1 && (vehicle_in_ == nullptr || vehicle_in_->peers() >= 1);
   });
   matched_ccu_ = ok;
   if (!ok && !events_.interrupted()) {

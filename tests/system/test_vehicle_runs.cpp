@@ -1,7 +1,7 @@
 // Vehicle runs over Fast DDS (issue 15, docs/vehicle.md): bbw_launch starts the processes a
 // vehicle scenario declares (bbw_ccu, four bbw_corner, bbw_vehicle, bbw_pedal) in lockstep; the
-// vehicle's truth equals the in-process run's (bbw_vehicle_inproc) byte for byte, and summary.json
-// carries the `vehicle` object. Domains 70-71.
+// vehicle's truth and the CCU's and corners' logs equal the in-process run's (bbw_vehicle_inproc)
+// byte for byte, and summary.json carries the `vehicle` object. Domains 70-71.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -38,6 +38,12 @@ TEST(SystemVehicleRun, DryStopOverDdsEqualsTheInProcessRun) {
   const std::string truth_dds = slurp(dir + "/dds/vehicle_truth.csv");
   ASSERT_GT(truth_dds.size(), 100000u);  // 1400 periods
   EXPECT_TRUE(truth_dds == slurp(dir + "/mem/vehicle_truth.csv")) << "the DDS run's vehicle differs from the in-process run's";
+  // The CCU's and the corners' logs too (the same node cores, the same lockstep protocol).
+  for (const char* log : {"ccu_FL.csv", "ccu_RR.csv", "ccu_periods.csv", "corner_FL_periods.csv", "corner_RR_periods.csv"}) {
+    const std::string d = slurp(dir + "/dds/" + log);
+    EXPECT_FALSE(d.empty()) << log;
+    EXPECT_TRUE(d == slurp(dir + "/mem/" + log)) << log << " differs between Fast DDS and in process";
+  }
   EXPECT_NE(slurp(dir + "/dds/vehicle.out").find("1400 periods"), std::string::npos);
   EXPECT_NE(slurp(dir + "/dds/pedal.out").find("1400 periods"), std::string::npos);
   const std::string summary = slurp(dir + "/dds/summary.json");

@@ -14,13 +14,16 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/common/data_path.hpp"
 #include "bbw/common/json.hpp"
 #include "bbw/common/strict_yaml.hpp"
 #include "bbw/faults/monitor_yaml.hpp"
+#include "bbw/node/csv_log.hpp"
 #include "bbw/vehicle_run/metrics.hpp"
 #include "bbw/vehicle_run/vehicle_run.hpp"
 
@@ -124,9 +127,21 @@ int main(int argc, char** argv) {
     std::filesystem::create_directories(out_dir, ec);
     if (ec || !std::filesystem::is_directory(out_dir)) throw std::runtime_error(out_dir + ": cannot create output directory");
     bbw::vehicle_run::VehicleRun run(scenario, calibrator, options);
+    // The CCU's and the corners' logs, as bbw_inproc and the DDS processes write them.
+    bbw::node::CcuCsvLog ccu_log(out_dir, run.in_process().ccu());
+    run.in_process().ccu().set_observer(&ccu_log);
+    std::vector<std::unique_ptr<bbw::node::CornerPeriodsLog>> corner_logs;
+    for (std::size_t i = 0; i < run.in_process().corners(); ++i) {
+      const std::string name = bbw::corner_name(run.in_process().corner(i).corner());
+      corner_logs.push_back(std::make_unique<bbw::node::CornerPeriodsLog>(out_dir + "/corner_" + name + "_periods.csv", 0));
+      run.in_process().set_corner_observer(i, corner_logs.back().get());
+    }
     const auto t0 = std::chrono::steady_clock::now();
     run.run();
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    run.in_process().ccu().set_observer(nullptr);
+    ccu_log.flush();
+    for (auto& l : corner_logs) l->flush();
     const auto m = bbw::vehicle_run::vehicle_metrics(scenario, run);
     write_csv(out_dir + "/vehicle.csv", run.trace());
     bbw::vehicle_run::write_truth_csv(out_dir + "/vehicle_truth.csv", run.vehicle_node().truth());

@@ -37,7 +37,8 @@ void VehicleRun::vehicle_period(std::uint64_t k) {
     if (!run_.corner_alive(i)) vehicle_.corner_lost(slot_of_channel_[i]);
   }
   const msg::VehicleSensors& sensors = vehicle_.simulate_period(k, n);
-  const msg::PedalSample& pedal = pedal_.sample(k, sensors.time_s());
+  // The pedal reads at the period's end as the node computes it (bbw_pedal does the same).
+  const msg::PedalSample& pedal = pedal_.sample(k, run_.ccu().period_end_s(k));
   brake_.on_vehicle(sensors);
   brake_.on_pedal(pedal);
   // The caliper temperatures the vehicle computed reach the corners' plants from the next period.
