@@ -59,6 +59,18 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
   }
   instances_.resize(node_.channels());
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
+  if (options.vehicle != nullptr) {
+    const dds::Partition run{dds::run_partition(options.participant.run_id)};
+    vehicle_in_ = std::make_unique<dds::DdsInlet<msg::VehicleSensorsPubSubType>>(
+        participant_, dds::kVehicleSensorsTopic, dds::profiles_for(true).measurement_reader, events, run);
+    pedal_in_ = std::make_unique<dds::DdsInlet<msg::PedalSamplePubSubType>>(
+        participant_, dds::kPedalTopic, dds::profiles_for(true).measurement_reader, events, run);
+    vehicle_participant_ = node_.add_participant("vehicle");
+    pedal_participant_ = node_.add_participant("pedal");
+    vehicle::Vehicle v(options.vehicle->vehicle.vehicle, options.vehicle->road);
+    v.reset(options.vehicle->initial_speed_m_s, options.vehicle->disc_C, options.vehicle->caliper_C);
+    brake_.emplace(options.vehicle->brake, scenario.ccu_period_s, v.state());
+  }
   if (options.process_faults) {
     for (const faults::ProcessAction& a : faults::process_actions(options.schedule)) {
       if (a.target == faults::Target::CCU) {
@@ -75,6 +87,8 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
 
 CcuApp::~CcuApp() {
   node_.set_observer(nullptr);
+  vehicle_in_.reset();
+  pedal_in_.reset();
   // The readers go before the participant (members are destroyed after this body).
   blocks_.clear();
   health_.clear();
@@ -90,6 +104,21 @@ void CcuApp::drain_health() {
   }
 }
 
+// A vehicle run: the vehicle's and the pedal's period reports into the brake functions and the barrier.
+void CcuApp::drain_vehicle() {
+  if (!brake_) return;
+  while (vehicle_in_->take(vehicle_msg_)) {
+    if (vehicle_msg_.run_id() != options_.participant.run_id) continue;
+    brake_->on_vehicle(vehicle_msg_);
+    node_.participant_done(vehicle_participant_, vehicle_msg_.step());
+  }
+  while (pedal_in_->take(pedal_msg_)) {
+    if (pedal_msg_.run_id() != options_.participant.run_id) continue;
+    brake_->on_pedal(pedal_msg_);
+    node_.participant_done(pedal_participant_, pedal_msg_.step());
+  }
+}
+
 bool CcuApp::wait_for_corners(std::string& error) {
   const int n = static_cast<int>(node_.channels());
   const bool ok = events_.wait_for(options_.discovery_timeout, [&] {
@@ -97,6 +126,13 @@ bool CcuApp::wait_for_corners(std::string& error) {
     bool all = calibration_.peers() >= n;
     for (const auto& c : commands_) all = all && c->peers() >= 1;
     for (std::size_t i = 0; i < node_.channels(); ++i) all = all && node_.channel(i).health >= 0 && blocks_[i]->peers() >= 1;
+    if (brake_) {
+      all = all && vehicle_in_->peers() >= 1 && pedal_in_->peers() >= 1;
+      // The pedal reads the front-left corner's commands (its grants).
+      for (std::size_t i = 0; i < node_.channels(); ++i) {
+        if (node_.channel(i).slot == 0) all = all && commands_[i]->peers() >= 2;
+      }
+    }
     return all;
   });
   if (!ok && !events_.interrupted()) {
@@ -206,6 +242,7 @@ int CcuApp::run(std::string& error) {
           if (node_.channel(i).slot == slot && !wait_for_rejoin(i, ++expected_incarnation[slot], error)) return kExitPeerLost;
         }
       }
+      if (brake_) brake_->plan(node_);  // from the vehicle's and pedal's readings of period k - 1
       send_commands(k, false);
       const double t_end = node_.period_end_s(k);
       // Wait until every corner's block k has arrived, or its writer is gone (a dead process).
@@ -213,6 +250,7 @@ int CcuApp::run(std::string& error) {
       // may have matched our writer only after it was sent.
       auto pred = [&] {
         drain_blocks(t_end);
+        drain_vehicle();
         drain_health();
         drain_qos_events(t_end, true);
         return node_.period_complete(k);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <bbw/idl/bbw_msgsPubSubTypes.h>
+#include <bbw/idl/bbw_vehicle_msgsPubSubTypes.h>
 
 #include <array>
 #include <chrono>
@@ -26,6 +27,7 @@
 #include "bbw/dds/ports.hpp"
 #include "bbw/node/ccu_node.hpp"
 #include "bbw/node/csv_log.hpp"
+#include "bbw/vehicle_run/vehicle_nodes.hpp"
 
 namespace bbw::ccu {
 
@@ -47,6 +49,9 @@ struct CcuOptions : runtime::ProcessOptions {
   bool friction_feedback = true;                  // let corners use compensated feedback
   faults::MonitorParams monitor;                  // config/faults/monitor.yaml (--monitor)
   faults::FaultSchedule schedule;
+  // A vehicle run (issue 15, docs/vehicle.md): the vehicle and the pedal join the lockstep
+  // barrier and the CCU's brake functions command the corners. nullptr: a four-corner run.
+  const vehicle_run::VehicleScenario* vehicle = nullptr;
 };
 
 class CcuApp {
@@ -70,6 +75,7 @@ class CcuApp {
   bool wait_for_rejoin(std::size_t channel, std::uint32_t incarnation, std::string& error);
   [[noreturn]] void freeze_for_kill(double at_s);
   double realtime_now_s() const;
+  void drain_vehicle();
 
   const scenario::Scenario& scenario_;
   CcuOptions options_;
@@ -98,6 +104,13 @@ class CcuApp {
   std::uint64_t periods_done_ = 0;
   std::optional<double> kill_at_s_;                       // scheduled CCU kill
   std::vector<std::pair<std::uint64_t, std::size_t>> restarts_;  // lockstep: (step, slot)
+  // A vehicle run: the vehicle's and the pedal's readings, their barrier places, the brake functions.
+  std::unique_ptr<dds::DdsInlet<msg::VehicleSensorsPubSubType>> vehicle_in_;
+  std::unique_ptr<dds::DdsInlet<msg::PedalSamplePubSubType>> pedal_in_;
+  std::optional<vehicle_run::BrakeFunctions> brake_;
+  std::size_t vehicle_participant_ = 0, pedal_participant_ = 0;
+  msg::VehicleSensors vehicle_msg_;
+  msg::PedalSample pedal_msg_;
 };
 
 }  // namespace bbw::ccu

@@ -32,6 +32,7 @@
 #include "bbw/runtime/signals.hpp"
 #include "bbw/scenario/load.hpp"
 #include "bbw/security/dds_security.hpp"
+#include "bbw/vehicle_run/vehicle_scenario.hpp"
 #include "ccu_app.hpp"
 
 namespace {
@@ -77,15 +78,25 @@ int main(int argc, char** argv) {
 
   // Config is loaded and validated before any DDS entity exists.
   std::optional<bbw::scenario::Scenario> scenario;
+  std::optional<bbw::vehicle_run::VehicleScenario> vehicle;
   std::optional<bbw::calibration::CalibratorConfig> calibrator;
   try {
     if (!secure_dir.empty()) {
       opt.participant.properties = bbw::security::participant_properties(
           bbw::security::files_for(secure_dir, bbw::security::kCcuIdentity));
     }
-    auto fs = bbw::faults::load_fault_scenario(scenario_file);
-    scenario = std::move(fs.scenario);
-    opt.schedule = std::move(fs.faults);
+    if (bbw::vehicle_run::is_vehicle_scenario(scenario_file)) {
+      // A vehicle scenario (issue 15): its calipers, and the vehicle and pedal as participants.
+      vehicle.emplace(bbw::vehicle_run::load_vehicle_scenario(scenario_file));
+      if (opt.mode != bbw::runtime::ClockMode::Lockstep) throw std::invalid_argument("a vehicle scenario runs in lockstep only");
+      scenario = vehicle->corners.scenario;
+      opt.schedule = vehicle->corners.faults;
+      opt.vehicle = &*vehicle;
+    } else {
+      auto fs = bbw::faults::load_fault_scenario(scenario_file);
+      scenario = std::move(fs.scenario);
+      opt.schedule = std::move(fs.faults);
+    }
     if (calibrator_file.empty()) calibrator_file = bbw::data::path("config/calibrator/robust.yaml");
     if (monitor_file.empty()) monitor_file = bbw::data::path("config/faults/monitor.yaml");
     calibrator = bbw::calibration::load_config(calibrator_file);

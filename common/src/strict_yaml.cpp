@@ -227,6 +227,17 @@ std::string Reader::child_path(const std::string& key) const {
   return path_.empty() ? key : path_ + "." + key;
 }
 
+std::vector<std::string> Reader::strings(const std::string& key) {
+  const YAML::Node n = required(key);
+  if (!n.IsSequence()) fail(key, std::string("must be a list of strings, got ") + type_name(n));
+  std::vector<std::string> out;
+  for (const auto& e : n) {
+    if (!e.IsScalar()) fail(key, "every entry must be a string");
+    out.push_back(e.Scalar());
+  }
+  return out;
+}
+
 bool Reader::has(const std::string& key) const {
   const YAML::Node n = node_[key];
   return n.IsDefined() && !n.IsNull();

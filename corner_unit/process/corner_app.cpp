@@ -69,20 +69,29 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
                 dds::Partition{own_partition(options)}),
       calibration_(participant_, dds::kCalibrationTopic, "state_reader", events,
                    dds::Partition{dds::run_partition(options.participant.run_id)}) {
+  if (options.vehicle) {
+    vehicle_in_ = std::make_unique<dds::DdsInlet<msg::VehicleSensorsPubSubType>>(
+        participant_, dds::kVehicleSensorsTopic, dds::profiles_for(true).measurement_reader, events,
+        dds::Partition{dds::run_partition(options.participant.run_id)});
+  }
   if (!options.periods_log.empty()) {
     periods_log_ = std::make_unique<node::CornerPeriodsLog>(options.periods_log, options.incarnation);
     node_.set_observer(periods_log_.get());
   }
 }
 
-CornerApp::~CornerApp() = default;
+CornerApp::~CornerApp() { vehicle_in_.reset(); }
 
 void CornerApp::publish_health(std::uint8_t status) { health_.send(node_.health(status)); }
 
 bool CornerApp::wait_for_ccu(std::string& error) {
   const auto timeout = options_.match_timeout.count() > 0 ? options_.match_timeout : options_.discovery_timeout;
   const bool ok = events_.wait_for(timeout, [&] {
-    return blocks_.peers() >= 1 && commands_.peers() >= 1 && calibration_.peers() >= 1 && health_.peers() >= 1;
+    // A vehicle run: the vehicle reads our blocks too (its reader must have matched before block 0,
+    // which is not sent again), and we read its sensors.
+    const int block_readers = vehicle_in_ == nullptr ? 1 : 2;
+    return blocks_.peers() >= block_readers && commands_.peers() >= 1 && calibration_.peers() >= 1 &&
+           health_.peers() >= 1 && (vehicle_in_ == nullptr || vehicle_in_->peers() >= 1);
   });
   matched_ccu_ = ok;
   if (!ok && !events_.interrupted()) {
@@ -127,6 +136,13 @@ void CornerApp::drain_inputs() {
     node_.on_command(command_in_, command_source(), started_ ? sim_now_s() : 0.0);
   }
   while (calibration_.take(state_in_)) node_.on_calibration(state_in_);
+  if (vehicle_in_ == nullptr) return;
+  const std::size_t slot = dds::corner_index(options_.corner);
+  while (vehicle_in_->take(vehicle_msg_)) {
+    if (vehicle_msg_.run_id() != options_.participant.run_id) continue;
+    node_.set_caliper_temperature_C(vehicle_msg_.caliper_temperature_C()[slot]);
+    vehicle_step_ = std::max(vehicle_step_, static_cast<std::int64_t>(vehicle_msg_.step()));
+  }
 }
 
 void CornerApp::simulate_period(std::uint64_t k) {
@@ -193,9 +209,11 @@ int CornerApp::run(std::string& error) {
     // Lockstep without a CCU (its command writer lost its liveliness): the corner runs on alone
     // under its watchdog.
     if (!lockstep || !node_.ccu_lost()) {
+      // A vehicle run: also the vehicle's period k - 1 (its caliper temperature for period k).
       const runtime::PeriodStart begun = clock->begin(k, [&] {
         drain_inputs();
-        return node_.granted(k) || ccu_gone();
+        const bool vehicle_ready = vehicle_in_ == nullptr || k == first || vehicle_step_ >= static_cast<std::int64_t>(k) - 1;
+        return (node_.granted(k) && vehicle_ready) || ccu_gone() || node_.latest_command().stop();
       });
       if (begun == runtime::PeriodStart::Interrupted) break;
       if (begun == runtime::PeriodStart::TimedOut) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <bbw/idl/bbw_msgsPubSubTypes.h>
+#include <bbw/idl/bbw_vehicle_msgsPubSubTypes.h>
 
 #include <chrono>
 #include <memory>
@@ -56,6 +57,9 @@ struct CornerOptions : runtime::ProcessOptions {
   // first period at or after it, from a released plant, with sample seq 1).
   std::uint32_t incarnation = 0;
   double resume_at_s = 0.0;
+  // A vehicle run (issue 15): the caliper's temperature comes from bbw_vehicle's VehicleSensors;
+  // in lockstep the corner simulates period k once the vehicle's period k - 1 is in.
+  bool vehicle = false;
 };
 
 // Exit statuses (docs/distributed.md).
@@ -104,6 +108,9 @@ class CornerApp {
   dds::DdsOutlet<msg::CornerHealthPubSubType> health_;
   dds::DdsInlet<msg::ClampCommandPubSubType> commands_;
   dds::DdsInlet<msg::CalibrationStatePubSubType> calibration_;
+  std::unique_ptr<dds::DdsInlet<msg::VehicleSensorsPubSubType>> vehicle_in_;  // a vehicle run only
+  msg::VehicleSensors vehicle_msg_;
+  std::int64_t vehicle_step_ = -1;  // newest VehicleSensors step applied
 
   std::chrono::steady_clock::time_point t0_{};  // realtime: wall time of the first period
   std::unique_ptr<node::CornerPeriodsLog> periods_log_;

@@ -34,6 +34,7 @@
 #include "bbw/runtime/stats_file.hpp"
 #include "bbw/scenario/load.hpp"
 #include "bbw/security/dds_security.hpp"
+#include "bbw/vehicle_run/vehicle_scenario.hpp"
 #include "corner_app.hpp"
 
 namespace {
@@ -95,9 +96,18 @@ int main(int argc, char** argv) {
       opt.participant.properties = bbw::security::participant_properties(
           bbw::security::files_for(secure_dir, bbw::security::corner_identity(corner_arg)));
     }
-    auto fs = bbw::faults::load_fault_scenario(scenario_file);
-    scenario = std::move(fs.scenario);
-    opt.schedule = std::move(fs.faults);
+    if (bbw::vehicle_run::is_vehicle_scenario(scenario_file)) {
+      // A vehicle scenario (issue 15): this corner's caliper; its temperature from the vehicle.
+      auto vs = bbw::vehicle_run::load_vehicle_scenario(scenario_file);
+      if (opt.mode != bbw::runtime::ClockMode::Lockstep) throw std::invalid_argument("a vehicle scenario runs in lockstep only");
+      scenario = std::move(vs.corners.scenario);
+      opt.schedule = std::move(vs.corners.faults);
+      opt.vehicle = true;
+    } else {
+      auto fs = bbw::faults::load_fault_scenario(scenario_file);
+      scenario = std::move(fs.scenario);
+      opt.schedule = std::move(fs.faults);
+    }
     bool found = false;
     for (std::size_t i = 0; i < scenario->corners.size(); ++i) {
       if (scenario->corners[i].name == corner_arg) {

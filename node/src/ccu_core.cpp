@@ -125,6 +125,18 @@ const std::array<CornerPlan, kSlots>& CcuCore::plan(double time_s) {
       if (supervisors_[s] && plans_[s].mode == CommandMode::Force) plans_[s].clamp_force_kN = a.force_kN[s];
     }
   }
+  for (std::size_t s = 0; s < kSlots; ++s) {
+    if (!supervisors_[s] || !brake_commands_[s] || !plans_[s].available) continue;
+    plans_[s].mode = CommandMode::Force;
+    plans_[s].clamp_force_kN = *brake_commands_[s];
+  }
+  if (curve_feedback_) {
+    for (std::size_t s = 0; s < kSlots; ++s) {
+      if (!supervisors_[s] || !plans_[s].available) continue;
+      plans_[s].feedback = corner_unit::ForceFeedback::Curve;
+      plans_[s].curve = *curve_feedback_;
+    }
+  }
   return plans_;
 }
 

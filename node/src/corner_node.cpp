@@ -154,6 +154,7 @@ bool CornerNode::alone() const {
 const msg::MeasurementBlock* CornerNode::simulate_period(std::uint64_t k) {
   const double dt = scenario_.plant_dt_s;
   scenario::ExternalInputs ext;
+  ext.temperature_C = caliper_temperature_C_;
   const bool valid = have_command_ && latest_command_.valid();
   if (valid && !ccu_lost_) ++stats_.commands_applied;
   const bool calibrated = model_.version > 0 && latest_command_.use_friction_comp();

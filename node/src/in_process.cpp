@@ -203,6 +203,7 @@ bool InProcessRun::step() {
     for (const msg::ClampCommand& c : ccu_.commands(k, false)) command_out_->send(c);
   }
   for (CornerEnd& c : corners_) corner_period(c, k);
+  if (period_hook_) period_hook_(k);
   if (ccu_alive_) {
     ccu_intake(t_end);
     for (std::size_t i = 0; i < corners_.size(); ++i) {

@@ -113,7 +113,8 @@ const Measurement& Plant::step(const PlantInputs& inputs, double dt_s) {
   const double h = dt_s / n;
   for (int k = 0; k < n; ++k) {
     s_.time_s += h;
-    s_.temperature_C = c_.temperature_C + c_.temperature_rate_C_per_s * s_.time_s;
+    s_.temperature_C = std::isnan(inputs.temperature_C) ? c_.temperature_C + c_.temperature_rate_C_per_s * s_.time_s
+                                                        : inputs.temperature_C;
     substep(i_cmd, torque_scale, inputs.seized, h);
   }
   // Key friction: rate-independent, so one update per step at the step's end position is

@@ -113,7 +113,7 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
   sample_.force_feedback_kN = in.force_feedback_kN;
   sample_.current_command_A = out.current_command_A;
 
-  readings_ = plant_.step(plant::PlantInputs{out.current_command_A, ext.torque_scale, ext.actuator_seized}, dt_s);
+  readings_ = plant_.step(plant::PlantInputs{out.current_command_A, ext.torque_scale, ext.actuator_seized, ext.temperature_C}, dt_s);
   if (ext.sensor_hook != nullptr) ext.sensor_hook->apply(readings_);
   const plant::Measurement& y = readings_;
   const plant::PlantState& s = plant_.state();

@@ -14,6 +14,9 @@
 #include "bbw/plant/params_yaml.hpp"
 #include "bbw/scenario/load.hpp"
 #include "bbw/scenario/population.hpp"
+#include "bbw/brake/brake_yaml.hpp"
+#include "bbw/vehicle/params_yaml.hpp"
+#include "bbw/vehicle_run/vehicle_scenario.hpp"
 
 namespace fs = std::filesystem;
 
@@ -29,6 +32,13 @@ TEST(EveryConfig, EachYamlFileLoadsWithItsFoldersLoader) {
       {"analysis", [](const std::string& f) { bbw::analyze::load_options_file(f); }},
       {"faults", [](const std::string& f) { bbw::faults::load_monitor_params(f); }},
       {"population", [](const std::string& f) { bbw::scenario::load_population_spec(f); }},
+      // Issue 15: the vehicle and the CCU's brake functions; vehicle scenarios and their calipers.
+      {"vehicle", [](const std::string& f) {
+         if (fs::path(f).filename() == "brake_control.yaml") bbw::brake::load_brake_control(f);
+         else bbw::vehicle::load_vehicle_config(f);
+       }},
+      {"scenarios/vehicle", [](const std::string& f) { bbw::vehicle_run::load_vehicle_scenario(f); }},
+      {"scenarios/vehicle/corners", [](const std::string& f) { bbw::faults::load_fault_scenario(f); }},
   };
   int loaded = 0;
   for (const auto& entry : fs::recursive_directory_iterator(root)) {

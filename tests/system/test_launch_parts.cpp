@@ -191,3 +191,31 @@ TEST(RunStats, MissingUnknownRepeatedAndMalformedKeysAreErrorsNamingFileAndKey) 
 }
 
 }  // namespace
+
+#include "out_dir.hpp"
+#include "vehicle_summary.hpp"
+
+// A vehicle run's files (issue 15) are the launcher's own: a new run into the folder replaces them.
+TEST(LaunchParts, VehicleRunFilesAreRunOutputs) {
+  for (const char* f : {"vehicle.out", "pedal.err", "vehicle_truth.csv", "vehicle.json", "vehicle_plots.gp", "speeds.png",
+                        "path.png"}) {
+    EXPECT_TRUE(bbw::launch::is_run_output_name(f)) << f;
+  }
+  EXPECT_FALSE(bbw::launch::is_run_output_name("vehicle_notes.txt"));
+}
+
+// bbw_vehicle's vehicle.json becomes summary.json's `vehicle` object.
+TEST(LaunchParts, VehicleSummaryIsMergedIntoSummaryJson) {
+  const std::string dir = (std::filesystem::temp_directory_path() / ("bbw_vehicle_merge_" + std::to_string(::getpid()))).string();
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/summary.json") << "{\n  \"scenario\": \"x\"\n}\n";
+  std::ofstream(dir + "/vehicle.json") << "{\"vehicle\": {\"stopping_distance_m\": 42.5}}";
+  bbw::launch::merge_vehicle_summary(dir);
+  std::ifstream in(dir + "/summary.json");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_EQ(ss.str(), "{\n  \"scenario\": \"x\"\n,\"vehicle\": {\"stopping_distance_m\": 42.5}}\n");
+  std::ofstream(dir + "/vehicle.json") << "not json";
+  EXPECT_THROW(bbw::launch::merge_vehicle_summary(dir), std::runtime_error);
+  std::filesystem::remove_all(dir);
+}

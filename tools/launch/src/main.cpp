@@ -49,6 +49,7 @@
 #include "out_dir.hpp"
 #include "partial_summary.hpp"
 #include "summary.hpp"
+#include "vehicle_summary.hpp"
 #include "supervisor.hpp"
 
 namespace {
@@ -148,6 +149,7 @@ int main(int argc, char** argv) {
   plan.domain = domain;
   plan.discovery_s = opt.discovery_s;
   plan.secure = opt.secure;
+  plan.extra_processes = loaded->extra_processes;
 
   // A SIGINT/SIGTERM before the run's processes start (while the keys are created, say) still
   // leaves a partial summary marked interrupted, and the exit is 128 + the signal.
@@ -214,6 +216,7 @@ int main(int argc, char** argv) {
     run.ended_by_injected_ccu_kill = result.ccu_killed;
     run.launch_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     const auto t = bbw::launch::write_run_summary(run);
+    if (!plan.extra_processes.empty()) bbw::launch::merge_vehicle_summary(plan.out_dir);
     std::cout << "bbw_launch: done: simulated " << t.simulated_s << " s in " << t.wall_s << " s (real-time factor "
               << (t.wall_s > 0 ? t.simulated_s / t.wall_s : 0.0) << "), samples published " << t.published
               << ", received " << t.received << ", gaps " << t.gaps << "; " << plan.out_dir << "/summary.json"

@@ -8,6 +8,7 @@
 #include "bbw/faults/link_faults.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/scenario/load.hpp"
+#include "bbw/vehicle_run/vehicle_scenario.hpp"
 #include "bbw/scenario/run_checks.hpp"
 
 namespace bbw::launch {
@@ -50,8 +51,26 @@ Options parse_options(int argc, char** argv) {
 int requested_domain(const Options& o) { return dds::resolve_domain_id(o.domain_arg, std::getenv("BBW_DOMAIN"), -1); }
 
 LoadedRun load_run(const Options& o) {
-  auto fs = faults::load_fault_scenario(o.scenario_file);
-  LoadedRun r{std::move(fs.scenario), std::move(fs.faults)};
+  LoadedRun r;
+  if (vehicle_run::is_vehicle_scenario(o.scenario_file)) {
+    // A vehicle scenario declares its processes: the CCU, the corners, the vehicle, the pedal.
+    auto vs = vehicle_run::load_vehicle_scenario(o.scenario_file);
+    if (o.mode != "lockstep") throw std::invalid_argument(o.scenario_file + ": a vehicle scenario runs in lockstep only");
+    if (o.secure) throw std::invalid_argument(o.scenario_file + ": --secure is not supported for vehicle scenarios yet");
+    r.scenario = std::move(vs.corners.scenario);
+    r.scenario.name = vs.name;  // the run is the vehicle scenario's (its calipers' file is a part)
+    r.schedule = std::move(vs.corners.faults);
+    if (!faults::process_actions(r.schedule).empty()) {
+      throw std::invalid_argument(o.scenario_file + ": process faults in a vehicle scenario run in process only (bbw_vehicle_inproc)");
+    }
+    for (const std::string& p : vs.processes) {
+      if (p == "vehicle" || p == "pedal") r.extra_processes.push_back(p);
+    }
+  } else {
+    auto fs = faults::load_fault_scenario(o.scenario_file);
+    r.scenario = std::move(fs.scenario);
+    r.schedule = std::move(fs.faults);
+  }
   scenario::check_four_corner_run(r.scenario);
   if (!o.allow_large) scenario::check_run_size(r.scenario);
   for (const auto& a : faults::process_actions(r.schedule)) {

@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "bbw/faults/schedule.hpp"
 #include "bbw/scenario/scenario.hpp"
@@ -35,6 +36,9 @@ int requested_domain(const Options& o);
 struct LoadedRun {
   scenario::Scenario scenario;
   faults::FaultSchedule schedule;
+  // Processes beyond the CCU and the corners that the scenario declares (a vehicle scenario,
+  // issue 15: "vehicle", "pedal"); empty for a four-corner scenario.
+  std::vector<std::string> extra_processes;
 };
 
 // The scenario and its fault schedule, checked for a DDS run (four corners, size limits unless

@@ -13,7 +13,10 @@ bool is_run_output_name(const std::string& name) {
   static const std::regex own(
       "summary\\.json|report\\.html|report\\.gp|timeline\\.csv|timeline\\.png|keys\\.(out|err)|"
       "ccu\\.(out|err|stats)|ccu_periods\\.csv|ccu_(FL|FR|RL|RR)\\.csv|(loop|time)_(FL|FR|RL|RR)\\.png|"
-      "corner_(FL|FR|RL|RR)(\\.[0-9]+)?\\.(out|err|stats)|corner_(FL|FR|RL|RR)_periods\\.csv");
+      "corner_(FL|FR|RL|RR)(\\.[0-9]+)?\\.(out|err|stats)|corner_(FL|FR|RL|RR)_periods\\.csv|"
+      // A vehicle run (issue 15): bbw_vehicle's and bbw_pedal's outputs and plots.
+      "(vehicle|pedal)\\.(out|err)|vehicle_truth\\.csv|vehicle\\.json|vehicle_plots\\.gp(\\.log)?|"
+      "(speeds|slips|clamp_forces|mu_used|path)\\.png");
   return std::regex_match(name, own);
 }
 

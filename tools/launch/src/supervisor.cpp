@@ -179,6 +179,16 @@ void Supervisor::start() {
     ccu_args.insert(ccu_args.end(), profile_args_.begin(), profile_args_.end());
     children_.push_back(std::make_unique<Child>("bbw_ccu", ccu_args, plan_.out_dir + "/ccu.out", plan_.out_dir + "/ccu.err"));
     for (const auto& c : plan_.scenario->corners) spawn_corner(c.name, 0, 0.0);
+    // The further processes the scenario declares (a vehicle run: bbw_vehicle, bbw_pedal).
+    for (const std::string& p : plan_.extra_processes) {
+      const std::string name = "bbw_" + p;
+      std::vector<std::string> args{bin_ + "/" + name, "--scenario", plan_.scenario_file, "--domain",
+                                    std::to_string(plan_.domain), "--run-id", plan_.run_id, "--mode", plan_.mode,
+                                    "--discovery-timeout", std::to_string(plan_.discovery_s)};
+      if (p == "vehicle") args.insert(args.end(), {"--out", plan_.out_dir});
+      args.insert(args.end(), profile_args_.begin(), profile_args_.end());
+      children_.push_back(std::make_unique<Child>(name, args, plan_.out_dir + "/" + p + ".out", plan_.out_dir + "/" + p + ".err"));
+    }
   } catch (...) {
     for (auto& c : children_) c->stop(2000ms);
     throw;

@@ -33,6 +33,7 @@ struct RunPlan {
   int domain = 0;
   double discovery_s = 20.0;
   bool secure = false;
+  std::vector<std::string> extra_processes;  // "vehicle", "pedal": bbw_vehicle, bbw_pedal (issue 15)
 };
 
 struct SupervisedRun {

@@ -7,6 +7,10 @@ inline constexpr const char* kMeasurementTopic = "bbw/MeasurementBlock";
 inline constexpr const char* kCommandTopic = "bbw/ClampCommand";
 inline constexpr const char* kCalibrationTopic = "bbw/CalibrationState";
 inline constexpr const char* kHealthTopic = "bbw/CornerHealth";
+// A vehicle run (issue 15, idl/bbw_vehicle_msgs.idl): both in the run's partition, with the
+// measurement profiles (one sample per CCU period, the barrier's "period done").
+inline constexpr const char* kVehicleSensorsTopic = "bbw/VehicleSensors";
+inline constexpr const char* kPedalTopic = "bbw/PedalSample";
 
 struct ProfileNames {
   const char* measurement_writer;

@@ -69,6 +69,14 @@ class CcuCore {
   const std::array<CornerPlan, kSlots>& plan(double time_s);
   // The demanded total clamp force at time_s (sum of the nominal commands), kN.
   double demand_total_kN(double time_s) const;
+  // A vehicle run (issue 15): the CCU's brake functions (bbw/brake/) command each corner's clamp
+  // force instead of the scenario's pedal profile. A slot with a value is commanded that force
+  // in plan() when it is available; nullopt (the default) leaves plan() as it was.
+  void set_brake_commands(const std::array<std::optional<double>, kSlots>& clamp_force_kN) { brake_commands_ = clamp_force_kN; }
+  // A study of what calibration is worth (issue 15, docs/vehicle.md): every available corner is
+  // told to close its loop on `curve` (FEEDBACK_CURVE), e.g. the end-of-line curve, whatever the
+  // calibrator learns. nullopt (the default): plan() as it was.
+  void set_curve_feedback(const std::optional<calibration::Curve>& curve) { curve_feedback_ = curve; }
 
   const faults::CornerSupervisor& supervisor(std::size_t slot) const { return *supervisors_[slot]; }
 
@@ -80,6 +88,8 @@ class CcuCore {
   std::array<std::size_t, kSlots> scenario_index_{};
   std::optional<faults::Redistributor> redistributor_;
   std::array<CornerPlan, kSlots> plans_{};
+  std::array<std::optional<double>, kSlots> brake_commands_{};
+  std::optional<calibration::Curve> curve_feedback_;
   SampleOutcome outcome_;
 };
 

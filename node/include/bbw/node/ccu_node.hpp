@@ -119,6 +119,17 @@ class CcuNode {
   // Lockstep: a restarted corner has announced itself; its block is expected from now on.
   void expect_rejoin(std::size_t channel);
 
+  // A vehicle run (issue 15): the brake functions' clamp-force commands (CcuCore::set_brake_commands).
+  void set_brake_commands(const std::array<std::optional<double>, ccu::kSlots>& clamp_force_kN) {
+    core_.set_brake_commands(clamp_force_kN);
+  }
+  void set_curve_feedback(const std::optional<calibration::Curve>& curve) { core_.set_curve_feedback(curve); }
+  // Further lockstep participants (the vehicle, the pedal): each reports the periods it finished;
+  // one whose writer is gone no longer holds the barrier.
+  std::size_t add_participant(const std::string& name) { return barrier_.add(name); }
+  void participant_done(std::size_t participant, std::uint64_t step) { barrier_.done(participant, step); }
+  void participant_alive(std::size_t participant, bool alive) { barrier_.set_alive(participant, alive); }
+
   // Outputs. The commands for period `step` (or the stop command), one per corner; `log` tells
   // the observer (not for re-sends).
   const std::vector<msg::ClampCommand>& commands(std::uint64_t step, bool stop, bool log = true);

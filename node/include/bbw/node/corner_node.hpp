@@ -13,6 +13,7 @@
 #include <bbw/idl/bbw_msgs.h>
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 
 #include "bbw/dds/convert.hpp"
@@ -96,6 +97,9 @@ class CornerNode {
   // rated force range and rate; issue 17): `source` says who sent it.
   void on_command(const msg::ClampCommand& command, const corner::CommandSource& source, double arrival_s);
   void on_calibration(const msg::CalibrationState& state);
+  // A vehicle run (issue 15): the caliper's temperature as the vehicle computes it from the brake
+  // disc, applied from the next period on; NaN (the default) keeps the scenario's conditions.
+  void set_caliper_temperature_C(double temperature_C) { caliper_temperature_C_ = temperature_C; }
 
   // Starts at the CCU's first command for our first period (the start signal). Returns the first
   // period to simulate.
@@ -158,6 +162,7 @@ class CornerNode {
   calibration::FrictionTracker friction_;  // element and play states of the CCU's friction model
   CornerStats stats_;
   CornerObserver* observer_ = nullptr;
+  double caliper_temperature_C_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The number of plant steps in one CCU period; throws std::invalid_argument unless it is an

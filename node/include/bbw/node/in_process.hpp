@@ -73,6 +73,12 @@ class InProcessRun {
   // Observes corner i's periods, every incarnation of it (nullptr: none).
   void set_corner_observer(std::size_t i, CornerObserver* observer);
   void set_block_tap(BlockTap tap) { tap_ = std::move(tap); }
+  // Further participants (a vehicle run, issue 15): called in step(k) after every corner's period
+  // and before the CCU's intake and barrier check, so a participant that needs the corners'
+  // blocks of period k (the vehicle) runs its period k there and reports it to the CCU's barrier.
+  void set_period_hook(std::function<void(std::uint64_t step)> hook) { period_hook_ = std::move(hook); }
+  // Corner i's measurement-block topic (another subscriber, e.g. the vehicle, may read it).
+  transport::InMemoryTopic<msg::MeasurementBlock>& block_topic(std::size_t i) { return *corners_[i].blocks; }
 
   // Process state (process faults): the CCU is up; corner i's process is up (false after a kill
   // with no restart; a restart's new process is up at once and starts at its resume period).
@@ -128,6 +134,7 @@ class InProcessRun {
   std::vector<CornerEnd> corners_;
   std::vector<std::unique_ptr<CornerNode>> retired_;  // killed incarnations (their counters)
   BlockTap tap_;
+  std::function<void(std::uint64_t)> period_hook_;
   std::optional<double> ccu_kill_at_s_;
   bool ccu_alive_ = true;
   // Scratch messages, reused: a message's default constructor re-registers its TypeObject.

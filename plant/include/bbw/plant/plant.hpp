@@ -6,6 +6,8 @@
 // integrates with PlantParams::substeps internal substeps and never allocates.
 #pragma once
 
+#include <limits>
+
 #include <cstdint>
 #include <random>
 
@@ -25,6 +27,9 @@ struct PlantInputs {
   // turn whatever the torque; the clamp force stays where the pads hold it (creep still
   // relaxes it). The current follows its command as before.
   bool seized = false;
+  // The caliper's temperature from outside (a vehicle run: the brake disc heats it; issue 15).
+  // NaN (the default): the corner's Conditions (temperature and its ramp) as before.
+  double temperature_C = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Physical state (the truth).

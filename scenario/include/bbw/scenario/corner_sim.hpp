@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -72,6 +73,9 @@ struct ExternalInputs {
   // an optional sensor hook; neither changes anything at their defaults.
   double torque_scale = 1.0;
   bool actuator_seized = false;  // the mechanism jams (plant::PlantInputs::seized)
+  // The caliper's temperature from a vehicle run (plant::PlantInputs::temperature_C); NaN: the
+  // corner's own conditions.
+  double temperature_C = std::numeric_limits<double>::quiet_NaN();
   SensorHook* sensor_hook = nullptr;
 };
 

@@ -1,0 +1,69 @@
+// The CCU's brake functions for one period, from measurements only: the driver's demand from the
+// pedal's two sensors, the vehicle speed estimate, the brake-force distribution with load
+// transfer (the ideal front/rear split at the measured deceleration), the per-wheel slip
+// controllers, the yaw-moment limitation on split-mu (the front high side builds up at a limited
+// rate above the low side; the rear axle is select-low), and the wheel torque turned into a
+// clamp-force command through the CCU's brake model (2 mu_pad r_eff). Pure, no allocation per
+// period; dt passed in.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "bbw/brake/params.hpp"
+#include "bbw/brake/slip_controller.hpp"
+#include "bbw/brake/speed_estimator.hpp"
+
+namespace bbw::brake {
+
+struct BrakeMeasurements {
+  std::array<double, 4> wheel_rad_s{};      // FL, FR, RL, RR wheel-speed sensors
+  double ax_m_s2 = 0.0;                     // IMU
+  double ay_m_s2 = 0.0;
+  double yaw_rate_rad_s = 0.0;
+  double steer_rad = 0.0;                   // steering-angle sensor (road wheel, left positive)
+  double pedal_travel_mm = 0.0;             // pedal sensor 1
+  double pedal_force_N = 0.0;               // pedal sensor 2
+  std::array<double, 4> clamp_estimate_kN{};  // the CCU's clamp-force estimate per corner
+  std::array<bool, 4> available{true, true, true, true};
+};
+
+struct PedalDemand {
+  double demand = 0.0;           // 0..1 of full travel
+  bool sensors_disagree = false;
+};
+
+PedalDemand pedal_demand(const PedalDemandParams& p, double travel_mm, double force_N);
+
+struct BrakeOutput {
+  std::array<double, 4> clamp_force_kN{};
+  std::array<double, 4> torque_Nm{};
+  std::array<WheelDecision, 4> wheels{};
+  double demand = 0.0;
+  double decel_request_g = 0.0;
+  double speed_estimate_m_s = 0.0;
+  bool split_mu = false;
+  std::uint64_t pedal_disagreements = 0;
+};
+
+class BrakeController {
+ public:
+  explicit BrakeController(const BrakeControlParams& p);  // validates
+  const BrakeOutput& update(double dt_s, const BrakeMeasurements& m);
+  const BrakeOutput& last() const { return out_; }
+  const BrakeControlParams& params() const { return p_; }
+  // Wheel torque to clamp force through the CCU's brake model, and back.
+  double clamp_kN(std::size_t wheel, double torque_Nm) const;
+  double torque_Nm(std::size_t wheel, double clamp_kN) const;
+
+ private:
+  BrakeControlParams p_;
+  SpeedEstimator speed_;
+  std::array<SlipController, 4> slip_;
+  double ax_filt_ = 0.0;
+  double split_s_ = 0.0;        // time since split-mu was detected
+  bool split_ = false;
+  BrakeOutput out_;
+};
+
+}  // namespace bbw::brake

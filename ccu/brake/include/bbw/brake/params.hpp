@@ -1,0 +1,85 @@
+// Parameters of the CCU's brake functions (config/vehicle/brake_control.yaml, loader
+// bbw/brake/brake_yaml.hpp). The CCU's model of the car is its own copy of nominal values: it
+// never reads the plant's parameters.
+#pragma once
+
+namespace bbw::brake {
+
+struct CarModel {
+  double mass_kg = 1093.0;
+  double cg_to_front_axle_m = 1.156;
+  double cg_to_rear_axle_m = 1.423;
+  double cg_height_m = 0.575;
+  double track_front_m = 1.387;
+  double track_rear_m = 1.364;
+  double wheel_radius_m = 0.344;
+  double wheel_inertia_kg_m2 = 1.7;
+  double pad_mu = 0.38;                 // nominal pad friction
+  double front_effective_radius_m = 0.12;
+  double rear_effective_radius_m = 0.10;
+  double max_clamp_force_kN = 40.0;
+  // Understeer gradient of the linear single-track model (rad per m/s^2 of lateral acceleration):
+  // the driver's yaw rate is v delta / (L + K_us v^2).
+  double understeer_gradient_rad_s2_per_m = 1.6e-4;
+};
+
+struct PedalDemandParams {
+  double full_travel_mm = 80.0;
+  double full_force_N = 500.0;
+  double force_exponent = 1.6;
+  double disagreement = 0.1;            // travel fractions further apart: a sensor fault
+  double dead_band = 0.02;              // demand below this is 0
+  double full_demand_g = 1.2;           // deceleration asked for at full travel
+};
+
+struct SpeedEstimatorParams {
+  double up_gain_per_s = 50.0;          // towards the fastest wheel when it reads faster
+  double down_gain_per_s = 0.5;         // towards it when it reads slower while braking hard
+  double rolling_gain_per_s = 20.0;     // towards it when no wheel is braked hard
+  double bias_gain_per_s = 0.5;         // IMU bias learning while rolling freely
+  double wheel_filter_s = 0.005;
+};
+
+struct SlipControlParams {
+  double target_slip = 0.10;            // initial target
+  double min_target_slip = 0.04;
+  double max_target_slip = 0.25;
+  double activation_margin = 0.02;      // ABS takes over above target - margin ... or a deep wheel decel
+  double activation_wheel_decel_m_s2 = 25.0;
+  double kp_Nm_per_rad_s = 50.0;        // proportional on wheel-speed error
+  double ki_Nm_per_rad = 600.0;         // integral
+  double min_speed_m_s = 2.0;           // below it the ABS hands over to the driver's demand
+  double mu_filter_s = 0.03;            // tyre mu estimate filter
+  // Online target search (extremum seeking with a square-wave dither on the target).
+  double dither_slip = 0.015;
+  double dither_half_period_s = 0.2;
+  double dither_settle_s = 0.08;
+  double search_step = 0.01;
+  double search_threshold_mu = 0.005;
+};
+
+struct YawLimitParams {
+  bool enabled = true;
+  double asymmetry_ratio = 0.6;         // a front wheel's ABS torque below this share of the other's: split-mu
+  double min_difference_Nm = 300.0;     // ... and more than this apart (noise on low mu is no split)
+  double ramp_Nm_per_s = 1000.0;        // how fast the high side may exceed the low side
+  double initial_Nm = 200.0;
+  // Yaw-rate feedback (from measurements only): the measured yaw rate beyond the one the driver
+  // steers for (the steering-angle sensor through the single-track model) takes torque off the
+  // high side.
+  double yaw_error_gain_Nm_per_rad_s = 8000.0;
+  bool rear_select_low = true;
+};
+
+struct BrakeControlParams {
+  CarModel car;
+  PedalDemandParams pedal;
+  SpeedEstimatorParams speed;
+  SlipControlParams slip;
+  YawLimitParams yaw;
+  bool abs_enabled = true;
+
+  void validate() const;  // throws std::invalid_argument
+};
+
+}  // namespace bbw::brake

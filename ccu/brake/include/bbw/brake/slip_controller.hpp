@@ -1,0 +1,55 @@
+// Continuous per-wheel slip control (ABS for an electromechanical brake): while the driver's
+// torque would take the wheel past its target slip, a PI loop on the wheel-speed error holds
+// it at the target with a continuously varying torque (no pressure cycling). The target is
+// found online: the tyre's mu is estimated from the brake torque the CCU believes it applies
+// (its clamp-force estimate) and the wheel's deceleration, and a square-wave dither on the
+// target compares mu on either side (extremum seeking). Pure; the CCU period passed in.
+#pragma once
+
+#include "bbw/brake/params.hpp"
+
+namespace bbw::brake {
+
+struct WheelInputs {
+  double wheel_rad_s = 0.0;        // sensor reading
+  double ground_speed_m_s = 0.0;   // estimated speed of the wheel's centre over ground
+  double request_Nm = 0.0;         // the driver's torque for this wheel (distribution applied)
+  double applied_Nm = 0.0;         // the torque the CCU estimates the brake applies now
+  double load_N = 0.0;             // estimated vertical load
+};
+
+struct WheelDecision {
+  double torque_Nm = 0.0;
+  double slip = 0.0;               // measured slip (positive braking)
+  double target_slip = 0.0;
+  double mu_estimate = 0.0;
+  bool active = false;             // the slip controller limits the torque
+};
+
+class SlipController {
+ public:
+  SlipController(const SlipControlParams& p, double wheel_radius_m, double wheel_inertia_kg_m2);
+  const WheelDecision& update(double dt_s, const WheelInputs& in);
+  const WheelDecision& last() const { return d_; }
+  double target_slip() const { return target_; }
+
+ private:
+  void search(double dt_s, double slip);
+  SlipControlParams p_;
+  double radius_m_, inertia_kg_m2_;
+  double w_filt_ = 0.0, w_prev_ = 0.0, w_dot_ = 0.0;
+  bool started_ = false;
+  double integral_Nm_ = 0.0;
+  double mu_ = 0.0;
+  double target_;
+  // Extremum seeking.
+  double phase_s_ = 0.0;
+  int side_ = 1;
+  double sum_mu_ = 0.0;
+  int count_ = 0;
+  double mean_plus_ = 0.0, mean_minus_ = 0.0;
+  bool have_plus_ = false, have_minus_ = false;
+  WheelDecision d_;
+};
+
+}  // namespace bbw::brake

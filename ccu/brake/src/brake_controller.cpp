@@ -1,0 +1,159 @@
+#include "bbw/brake/brake_controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace bbw::brake {
+
+namespace {
+constexpr double kG = 9.81;
+
+void require(bool ok, const char* what) {
+  if (!ok) throw std::invalid_argument(what);
+}
+}  // namespace
+
+void BrakeControlParams::validate() const {
+  require(car.mass_kg > 0 && car.cg_to_front_axle_m > 0 && car.cg_to_rear_axle_m > 0 && car.cg_height_m > 0 &&
+              car.track_front_m > 0 && car.track_rear_m > 0 && car.wheel_radius_m > 0 && car.wheel_inertia_kg_m2 > 0 &&
+              car.pad_mu > 0 && car.front_effective_radius_m > 0 && car.rear_effective_radius_m > 0 &&
+              car.max_clamp_force_kN > 0,
+          "car: every value must be > 0");
+  require(pedal.full_travel_mm > 0 && pedal.full_force_N > 0 && pedal.force_exponent >= 1 && pedal.disagreement > 0 &&
+              pedal.dead_band >= 0 && pedal.dead_band < 0.5 && pedal.full_demand_g > 0,
+          "pedal: full travel, force, disagreement, full_demand_g > 0; exponent >= 1; dead_band in [0, 0.5)");
+  require(slip.min_target_slip > 0 && slip.min_target_slip <= slip.target_slip && slip.target_slip <= slip.max_target_slip &&
+              slip.max_target_slip < 0.5,
+          "slip: 0 < min_target_slip <= target_slip <= max_target_slip < 0.5");
+  require(slip.kp_Nm_per_rad_s >= 0 && slip.ki_Nm_per_rad >= 0 && slip.min_speed_m_s > 0 && slip.mu_filter_s > 0 &&
+              slip.dither_slip >= 0 && slip.dither_half_period_s > slip.dither_settle_s && slip.search_step >= 0,
+          "slip: gains >= 0, min_speed_m_s and mu_filter_s > 0, dither_half_period_s > dither_settle_s");
+  require(yaw.asymmetry_ratio > 0 && yaw.asymmetry_ratio < 1 && yaw.ramp_Nm_per_s > 0 && yaw.initial_Nm >= 0,
+          "yaw: asymmetry_ratio in (0, 1), ramp_Nm_per_s > 0, initial_Nm >= 0");
+  require(speed.up_gain_per_s > 0 && speed.down_gain_per_s >= 0 && speed.rolling_gain_per_s > 0 && speed.bias_gain_per_s >= 0,
+          "speed: gains must be >= 0 (up and rolling > 0)");
+}
+
+PedalDemand pedal_demand(const PedalDemandParams& p, double travel_mm, double force_N) {
+  const double by_travel = std::clamp(travel_mm / p.full_travel_mm, 0.0, 1.0);
+  const double by_force = std::pow(std::clamp(force_N / p.full_force_N, 0.0, 1.0), 1.0 / p.force_exponent);
+  PedalDemand d;
+  d.sensors_disagree = std::abs(by_travel - by_force) > p.disagreement;
+  // Agreeing: their mean; disagreeing: the larger (a failed sensor must not take the brake away).
+  double v = d.sensors_disagree ? std::max(by_travel, by_force) : 0.5 * (by_travel + by_force);
+  v = v < p.dead_band ? 0.0 : (v - p.dead_band) / (1.0 - p.dead_band);
+  d.demand = v;
+  return d;
+}
+
+BrakeController::BrakeController(const BrakeControlParams& p)
+    : p_(p),
+      speed_(p.speed, p.car.wheel_radius_m),
+      slip_{SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2),
+            SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2),
+            SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2),
+            SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2)} {
+  p_.validate();
+}
+
+double BrakeController::clamp_kN(std::size_t w, double torque) const {
+  const double r = w < 2 ? p_.car.front_effective_radius_m : p_.car.rear_effective_radius_m;
+  return std::clamp(torque / (2.0 * p_.car.pad_mu * r) / 1000.0, 0.0, p_.car.max_clamp_force_kN);
+}
+
+double BrakeController::torque_Nm(std::size_t w, double clamp) const {
+  const double r = w < 2 ? p_.car.front_effective_radius_m : p_.car.rear_effective_radius_m;
+  return 2.0 * p_.car.pad_mu * r * clamp * 1000.0;
+}
+
+const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements& m) {
+  const CarModel& c = p_.car;
+  const PedalDemand pd = pedal_demand(p_.pedal, m.pedal_travel_mm, m.pedal_force_N);
+  if (pd.sensors_disagree) ++out_.pedal_disagreements;
+  out_.demand = pd.demand;
+  const double z_request = pd.demand * p_.pedal.full_demand_g;
+  out_.decel_request_g = z_request;
+  bool any_active = false;
+  double held_slip = 1.0;
+  for (const SlipController& s : slip_) {
+    any_active = any_active || s.last().active;
+    if (s.last().active) held_slip = std::min(held_slip, s.target_slip());
+  }
+  if (!any_active) held_slip = 0.0;
+  const double v = speed_.update(dt_s, m.wheel_rad_s, m.ax_m_s2, any_active || z_request > 0.3, held_slip);
+  out_.speed_estimate_m_s = v;
+  // Load transfer at the measured deceleration (never more than requested).
+  ax_filt_ += std::min(1.0, dt_s / 0.03) * (m.ax_m_s2 - ax_filt_);
+  const double z_meas = std::clamp(-ax_filt_ / kG, 0.0, z_request);
+  const double L = c.cg_to_front_axle_m + c.cg_to_rear_axle_m;
+  const double total_N = c.mass_kg * kG * z_request;
+  const double front_share = std::clamp((c.cg_to_rear_axle_m + c.cg_height_m * z_meas) / L, 0.3, 0.9);
+  const double front_axle_load = c.mass_kg * kG * (c.cg_to_rear_axle_m + c.cg_height_m * z_meas) / L;
+  const double rear_axle_load = c.mass_kg * kG - front_axle_load;
+  // Lateral transfer from the IMU (ay > 0: left turn loads the right wheels).
+  const double roll = c.mass_kg * m.ay_m_s2 * c.cg_height_m;
+  const std::array<double, 4> load{0.5 * front_axle_load - 0.55 * roll / c.track_front_m,
+                                   0.5 * front_axle_load + 0.55 * roll / c.track_front_m,
+                                   0.5 * rear_axle_load - 0.45 * roll / c.track_rear_m,
+                                   0.5 * rear_axle_load + 0.45 * roll / c.track_rear_m};
+  for (std::size_t w = 0; w < 4; ++w) {
+    const double axle_force = total_N * (w < 2 ? front_share : 1.0 - front_share);
+    // Share within the axle by load: the more loaded wheel carries more.
+    const double axle_load = w < 2 ? front_axle_load : rear_axle_load;
+    const double share = axle_load > 0.0 ? std::max(0.0, load[w]) / axle_load : 0.5;
+    WheelInputs in;
+    in.wheel_rad_s = m.wheel_rad_s[w];
+    const double half_track = 0.5 * (w < 2 ? c.track_front_m : c.track_rear_m);
+    in.ground_speed_m_s = std::max(0.0, v + (w % 2 == 0 ? -1.0 : 1.0) * m.yaw_rate_rad_s * half_track);
+    in.request_Nm = axle_force * share * c.wheel_radius_m;
+    in.applied_Nm = torque_Nm(w, std::max(0.0, m.clamp_estimate_kN[w]));
+    in.load_N = std::max(100.0, load[w]);
+    if (!p_.abs_enabled) {
+      out_.wheels[w] = WheelDecision{};
+      out_.wheels[w].torque_Nm = in.request_Nm;
+      out_.torque_Nm[w] = in.request_Nm;
+      continue;
+    }
+    out_.wheels[w] = slip_[w].update(dt_s, in);
+    out_.torque_Nm[w] = out_.wheels[w].torque_Nm;
+  }
+  // Yaw-moment limitation: split-mu is seen when one front wheel is under slip control with a
+  // torque well below the other's; the high side may then exceed the low side only by a torque
+  // that grows at a limited rate (the driver has time to counter-steer). Rear: select-low.
+  // A corner the CCU cannot use (lost, failed) brakes nothing: count it as the low side, so the
+  // yaw-moment limitation also acts on the asymmetry a lost front corner leaves.
+  for (std::size_t w = 0; w < 4; ++w) {
+    if (!m.available[w]) out_.torque_Nm[w] = 0.0;
+  }
+  if (p_.abs_enabled && p_.yaw.enabled) {
+    const double lo = std::min(out_.torque_Nm[0], out_.torque_Nm[1]);
+    const double hi = std::max(out_.torque_Nm[0], out_.torque_Nm[1]);
+    const std::size_t low_side = out_.torque_Nm[0] <= out_.torque_Nm[1] ? 0 : 1;
+    const bool asym = (out_.wheels[low_side].active || !m.available[low_side]) && hi > 0.0 &&
+                      lo < p_.yaw.asymmetry_ratio * hi && hi - lo > p_.yaw.min_difference_Nm;
+    if (asym && !split_) {
+      split_ = true;
+      split_s_ = 0.0;
+    }
+    if (split_) {
+      split_s_ += dt_s;
+      // Braking the right (left) side more turns the car right (left), yaw rate negative (positive).
+      const double driver_yaw_rate = v * m.steer_rad / (L + c.understeer_gradient_rad_s2_per_m * v * v);
+      const double yaw_error = m.yaw_rate_rad_s - driver_yaw_rate;
+      const double towards_high = low_side == 0 ? -yaw_error : yaw_error;  // > 0: yawing towards the high side
+      const double allowed = std::max(lo, lo + p_.yaw.initial_Nm + p_.yaw.ramp_Nm_per_s * split_s_ -
+                                              p_.yaw.yaw_error_gain_Nm_per_rad_s * std::max(0.0, towards_high));
+      out_.torque_Nm[1 - low_side] = std::min(out_.torque_Nm[1 - low_side], allowed);
+      if (p_.yaw.rear_select_low) out_.torque_Nm[2] = out_.torque_Nm[3] = std::min(out_.torque_Nm[2], out_.torque_Nm[3]);
+    }
+    if (z_request <= 0.0) split_ = false;
+  }
+  out_.split_mu = split_;
+  for (std::size_t w = 0; w < 4; ++w) {
+    out_.clamp_force_kN[w] = m.available[w] ? clamp_kN(w, out_.torque_Nm[w]) : 0.0;
+  }
+  return out_;
+}
+
+}  // namespace bbw::brake

@@ -1,0 +1,91 @@
+#include "bbw/brake/slip_controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace bbw::brake {
+
+SlipController::SlipController(const SlipControlParams& p, double wheel_radius_m, double wheel_inertia_kg_m2)
+    : p_(p), radius_m_(wheel_radius_m), inertia_kg_m2_(wheel_inertia_kg_m2), target_(p.target_slip) {
+  if (!(wheel_radius_m > 0.0) || !(wheel_inertia_kg_m2 > 0.0)) throw std::invalid_argument("SlipController: radius and inertia must be > 0");
+}
+
+void SlipController::search(double dt_s, double slip) {
+  phase_s_ += dt_s;
+  if (phase_s_ > p_.dither_settle_s && std::abs(slip - (target_ + side_ * p_.dither_slip)) < 0.05) {
+    sum_mu_ += mu_;
+    ++count_;
+  }
+  if (phase_s_ < p_.dither_half_period_s) return;
+  if (count_ > 0) {
+    (side_ > 0 ? mean_plus_ : mean_minus_) = sum_mu_ / count_;
+    (side_ > 0 ? have_plus_ : have_minus_) = true;
+  }
+  if (have_plus_ && have_minus_ && side_ < 0) {
+    const double diff = mean_plus_ - mean_minus_;
+    if (diff > p_.search_threshold_mu) target_ += p_.search_step;
+    if (diff < -p_.search_threshold_mu) target_ -= p_.search_step;
+    target_ = std::clamp(target_, p_.min_target_slip, p_.max_target_slip);
+    have_plus_ = have_minus_ = false;
+  }
+  side_ = -side_;
+  phase_s_ = 0.0;
+  sum_mu_ = 0.0;
+  count_ = 0;
+}
+
+const WheelDecision& SlipController::update(double dt_s, const WheelInputs& in) {
+  const double a = std::min(1.0, dt_s / std::max(dt_s, 0.005));
+  if (!started_) {
+    w_filt_ = w_prev_ = in.wheel_rad_s;
+    started_ = true;
+  }
+  w_filt_ += a * (in.wheel_rad_s - w_filt_);
+  const double w_dot_raw = (w_filt_ - w_prev_) / dt_s;
+  w_prev_ = w_filt_;
+  const double b = std::min(1.0, dt_s / p_.mu_filter_s);
+  w_dot_ += b * (w_dot_raw - w_dot_);
+  const double v = in.ground_speed_m_s;
+  d_.slip = v > 0.5 ? std::clamp(1.0 - radius_m_ * w_filt_ / v, -1.0, 1.0) : 0.0;
+  // Tyre mu from the wheel's torque balance: R Fx = T_brake + I dw/dt (braking Fx > 0 here).
+  if (in.load_N > 0.0) {
+    const double mu_raw = (in.applied_Nm + inertia_kg_m2_ * w_dot_) / (radius_m_ * in.load_N);
+    mu_ += b * (mu_raw - mu_);
+  }
+  d_.mu_estimate = mu_;
+  const double request = std::max(0.0, in.request_Nm);
+  if (v < p_.min_speed_m_s || request <= 0.0) {
+    d_.active = false;
+    integral_Nm_ = request;
+    d_.torque_Nm = request;
+    d_.target_slip = target_;
+    return d_;
+  }
+  const double target = target_ + (d_.active ? side_ * p_.dither_slip : 0.0);
+  d_.target_slip = target;
+  const double w_target = (1.0 - target) * v / radius_m_;
+  const double err = w_filt_ - w_target;  // > 0: the wheel turns faster than the target: brake more
+  if (!d_.active) {
+    const bool deep = -w_dot_ * radius_m_ > p_.activation_wheel_decel_m_s2;
+    if (d_.slip > target_ - p_.activation_margin || deep) {
+      d_.active = true;
+      // Bumpless: start from the torque the brake applies now, less what the wheel's
+      // deceleration says is too much.
+      integral_Nm_ = std::clamp(in.applied_Nm + inertia_kg_m2_ * w_dot_, 0.0, request);
+    } else {
+      integral_Nm_ = request;
+      d_.torque_Nm = request;
+      return d_;
+    }
+  }
+  integral_Nm_ = std::clamp(integral_Nm_ + p_.ki_Nm_per_rad * err * dt_s, 0.0, request);
+  const double torque = std::clamp(integral_Nm_ + p_.kp_Nm_per_rad_s * err, 0.0, request);
+  d_.torque_Nm = torque;
+  // The driver asks for less than the wheel can carry: hand back.
+  if (integral_Nm_ >= request && err > 0.0) d_.active = false;
+  if (d_.active) search(dt_s, d_.slip);
+  return d_;
+}
+
+}  // namespace bbw::brake

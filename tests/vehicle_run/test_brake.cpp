@@ -1,0 +1,77 @@
+// The CCU's brake functions in isolation: the pedal's two sensors, the speed estimate, the
+// distribution, the slip controller's hand-over and limit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "bbw/brake/brake_controller.hpp"
+
+using namespace bbw::brake;
+
+TEST(PedalDemand, AgreeingSensorsAverageAndAFailedOneCannotTakeTheBrakeAway) {
+  PedalDemandParams p;
+  const double f = 0.5;
+  const PedalDemand ok = pedal_demand(p, f * p.full_travel_mm, p.full_force_N * std::pow(f, p.force_exponent));
+  EXPECT_FALSE(ok.sensors_disagree);
+  EXPECT_NEAR(ok.demand, (f - p.dead_band) / (1 - p.dead_band), 1e-9);
+  const PedalDemand travel_dead = pedal_demand(p, 0.0, p.full_force_N * std::pow(f, p.force_exponent));
+  EXPECT_TRUE(travel_dead.sensors_disagree);
+  EXPECT_NEAR(travel_dead.demand, ok.demand, 1e-9);
+  EXPECT_EQ(pedal_demand(p, 0.5, 0.1).demand, 0.0);  // dead band
+}
+
+TEST(SpeedEstimator, FollowsTheIMUWhileTheWheelsSlip) {
+  // The IMU reads the deceleration; every wheel slips 12 %, the slip the controllers hold.
+  SpeedEstimatorParams p;
+  SpeedEstimator e(p, 0.344);
+  double v = 25.0;
+  e.update(0.005, {v / 0.344, v / 0.344, v / 0.344, v / 0.344}, 0.0, false);
+  for (int i = 0; i < 400; ++i) {
+    v -= 8.0 * 0.005;
+    const double w = 0.88 * v / 0.344;  // every wheel at 12 % slip
+    e.update(0.005, {w, w, w, w}, -8.0, true, 0.12);  // the slip controllers hold 12 %
+  }
+  EXPECT_NEAR(e.speed_m_s(), v, 0.03 * 25.0);
+  EXPECT_GT(e.speed_m_s(), 0.93 * v);  // not dragged down to the slipping wheels
+}
+
+TEST(SlipController, PassesTheDriverThroughBelowTheTargetAndLimitsAbove) {
+  SlipControlParams p;
+  SlipController c(p, 0.344, 1.7);
+  WheelInputs in;
+  in.ground_speed_m_s = 20.0;
+  in.wheel_rad_s = 0.99 * 20.0 / 0.344;  // 1 % slip
+  in.request_Nm = 800.0;
+  in.applied_Nm = 800.0;
+  in.load_N = 3000.0;
+  for (int i = 0; i < 20; ++i) c.update(0.005, in);
+  EXPECT_FALSE(c.last().active);
+  EXPECT_DOUBLE_EQ(c.last().torque_Nm, 800.0);
+  in.wheel_rad_s = 0.7 * 20.0 / 0.344;  // 30 % slip
+  in.request_Nm = 2500.0;
+  in.applied_Nm = 2500.0;
+  for (int i = 0; i < 20; ++i) c.update(0.005, in);
+  EXPECT_TRUE(c.last().active);
+  EXPECT_LT(c.last().torque_Nm, 2500.0);
+}
+
+TEST(BrakeController, DistributesWithLoadTransferAndRefusesBadParams) {
+  BrakeControlParams p;
+  p.abs_enabled = false;
+  BrakeController b(p);
+  BrakeMeasurements m;
+  for (double& w : m.wheel_rad_s) w = 20.0 / 0.344;
+  m.pedal_travel_mm = p.pedal.full_travel_mm * 0.5;
+  m.pedal_force_N = p.pedal.full_force_N * std::pow(0.5, p.pedal.force_exponent);
+  m.ax_m_s2 = -6.0;
+  for (int i = 0; i < 100; ++i) b.update(0.005, m);
+  const BrakeOutput& o = b.last();
+  const double front = o.torque_Nm[0] + o.torque_Nm[1], rear = o.torque_Nm[2] + o.torque_Nm[3];
+  const double z = 6.0 / 9.81;
+  const double expect = (p.car.cg_to_rear_axle_m + p.car.cg_height_m * z) / (p.car.cg_to_front_axle_m + p.car.cg_to_rear_axle_m);
+  EXPECT_NEAR(front / (front + rear), expect, 0.01);
+  EXPECT_NEAR(o.clamp_force_kN[0], b.clamp_kN(0, o.torque_Nm[0]), 1e-12);
+  BrakeControlParams bad;
+  bad.slip.min_target_slip = 0.3;
+  EXPECT_THROW(BrakeController{bad}, std::invalid_argument);
+}
