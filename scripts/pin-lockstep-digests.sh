@@ -13,10 +13,9 @@ FILE="$ROOT/tests/node/data/lockstep_digests.txt"
 scenarios=$(grep -v '^#' "$FILE" | awk '{print $1}' | sort -u)
 new="$OUT/digests.txt"
 grep '^#' "$FILE" > "$new"
-domain=144
 for s in $scenarios; do
   n=$(basename "$s" .yaml)
-  "$BUILD/bin/bbw_launch" "$ROOT/$s" --out "$OUT/dds_$n" --mode lockstep --domain "$domain" --no-report > "$OUT/$n.log" 2>&1 \
+  "$BUILD/bin/bbw_launch" "$ROOT/$s" --out "$OUT/dds_$n" --mode lockstep --no-report > "$OUT/$n.log" 2>&1 \
     || { echo "pin: $s: ./bbw run failed (log $OUT/$n.log)" >&2; cat "$OUT/$n.log" >&2; exit 1; }
   files=$(grep -v '^#' "$FILE" | awk -v s="$s" '$1 == s {print $2}')
   inproc_ok=1

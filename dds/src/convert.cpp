@@ -8,7 +8,7 @@ void to_msg(const scenario::CornerSample& in, bool force_comp_used, msg::Measure
   out.seq(in.seq);
   out.time_s(in.time_s);
   out.position_rev(in.position_rev);
-  out.speed_rev_s(in.speed_rev_s);
+  out.speed_rev_per_s(in.speed_rev_per_s);
   out.force_internal_kN(in.force_internal_kN);
   out.force_external_kN(in.force_external_kN);
   out.force_true_kN(in.force_true_kN);

@@ -189,7 +189,7 @@ const msg::MeasurementBlock* CornerNode::simulate_period(std::uint64_t k) {
     double friction = 0.0;
     if (!model_.friction.delta_rev.empty()) {
       if (!friction_.started()) friction_.reset(model_.friction.delta_rev.size(), x);
-      friction = friction_.step_load_cell_excess(model_.friction, x, sim_.last().speed_rev_s, sim_.last().temperature_C);
+      friction = friction_.step_load_cell_excess(model_.friction, x, sim_.last().speed_rev_per_s, sim_.last().temperature_C);
     }
     ext.friction_estimate_kN = calibrated ? friction : 0.0;
     injector_.prepare(ext, t_end);

@@ -121,7 +121,7 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
   sample_.seq = ++seq_;
   sample_.time_s = time_s_;
   sample_.position_rev = y.position_rev;
-  sample_.speed_rev_s = y.speed_rev_per_s;
+  sample_.speed_rev_per_s = y.speed_rev_per_s;
   sample_.force_internal_kN = y.force_internal_kN;
   sample_.force_external_kN = y.force_external_kN;
   sample_.force_true_kN = s.force_true_kN;

@@ -90,7 +90,7 @@ bbw::msg::MeasurementSample plausible(std::uint64_t seq) {
   m.seq(seq);
   m.time_s(static_cast<double>(seq) * 0.001);
   m.position_rev(2.0 + std::sin(static_cast<double>(seq) * 0.01));
-  m.speed_rev_s(0.5);
+  m.speed_rev_per_s(0.5);
   m.force_internal_kN(10.0);
   m.force_external_kN(10.0);
   m.force_true_kN(10.0);

@@ -67,13 +67,13 @@ analysis::Recording record(const std::vector<std::string>& effects) {
     r.force.push_back(s.force_internal_kN);
     r.truth.push_back(s.force_external_kN);
     r.temperature.push_back(s.temperature_C);
-    speed.push_back(s.speed_rev_s);
+    speed.push_back(s.speed_rev_per_s);
     current.push_back(s.motor_current_A);
     command.push_back(s.command);
     current_command.push_back(s.current_command_A);
   }
   // The other measured channels a corner records.
-  // The resolver speed is the velocity (as bbw_analyze uses speed_rev_s by default).
+  // The resolver speed is the velocity (as bbw_analyze uses speed_rev_per_s by default).
   r.velocity = speed;
   r.channels = {{"motor_current_A", current}, {"command", command}, {"current_command_A", current_command}};
   return r;

@@ -166,7 +166,7 @@ analysis::Recording thermal_rig(double x_low_rev) {
     r.force.push_back(s.force_internal_kN);
     r.truth.push_back(s.force_external_kN);
     r.temperature.push_back(s.temperature_C);
-    r.velocity.push_back(s.speed_rev_s);
+    r.velocity.push_back(s.speed_rev_per_s);
   }
   return r;
 }

@@ -102,7 +102,7 @@ TEST(CalibratorAccuracy, ViscousTermFoundOfflineLowersOnlineErrorWhenSwitchedOn)
   const auto before = run_recording(off, rec);
   const auto after = run_recording(on, rec);
   auto no_speed = rec;
-  no_speed.speed_rev_s.clear();  // the position-slope fallback instead of the resolver speed
+  no_speed.speed_rev_per_s.clear();  // the position-slope fallback instead of the resolver speed
   const auto after_slope = run_recording(on, no_speed);
   std::printf("viscous on: max %.3f -> %.3f kN (slope fallback %.3f), rms %.3f -> %.3f kN, c_v %.4f kN/(rev/s)\n",
               before.score.max_abs_error_kN, after.score.max_abs_error_kN, after_slope.score.max_abs_error_kN,

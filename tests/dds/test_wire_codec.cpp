@@ -30,7 +30,7 @@ msg::MeasurementSample sample(double base) {
   s.seq(static_cast<unsigned long long>(base * 10));
   s.time_s(base + 0.001);
   s.position_rev(base + 0.002);
-  s.speed_rev_s(base + 0.003);
+  s.speed_rev_per_s(base + 0.003);
   s.force_internal_kN(base + 0.004);
   s.force_external_kN(base + 0.005);
   s.force_true_kN(base + 0.006);
@@ -55,7 +55,7 @@ TEST(WireCodec, MeasurementBlockWithItsSamples) {
   const auto out = round_trip<msg::MeasurementBlockPubSubType>(b);
   EXPECT_TRUE(out == b);
   ASSERT_EQ(out.samples().size(), msg::MAX_BLOCK_SAMPLES);
-  EXPECT_EQ(out.samples()[63].speed_rev_s(), 64.003);
+  EXPECT_EQ(out.samples()[63].speed_rev_per_s(), 64.003);
 }
 
 TEST(WireCodec, ClampCommand) {
@@ -134,7 +134,7 @@ TEST(WireCodec, ACornerSampleBecomesAWireSampleFieldByField) {
   c.seq = 42;
   c.time_s = 0.042;
   c.position_rev = 2.5;
-  c.speed_rev_s = -1.25;
+  c.speed_rev_per_s = -1.25;
   c.force_internal_kN = 10.5;
   c.force_external_kN = 10.0;
   c.force_true_kN = 9.9;
@@ -147,7 +147,7 @@ TEST(WireCodec, ACornerSampleBecomesAWireSampleFieldByField) {
   EXPECT_EQ(m.seq(), 42u);
   EXPECT_EQ(m.time_s(), 0.042);
   EXPECT_EQ(m.position_rev(), 2.5);
-  EXPECT_EQ(m.speed_rev_s(), -1.25);
+  EXPECT_EQ(m.speed_rev_per_s(), -1.25);
   EXPECT_EQ(m.force_internal_kN(), 10.5);
   EXPECT_EQ(m.force_external_kN(), 10.0);
   EXPECT_EQ(m.force_true_kN(), 9.9);

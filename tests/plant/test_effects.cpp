@@ -101,7 +101,7 @@ TEST(Effects, ViscousFrictionWidensTheLoopWithSpeed) {
       if (tr.since_reversal_rev[i] < kSaturatedTravel_rev || tr.direction[i] == 0) continue;
       rows.push_back(tr.direction[i] > 0 ? 1.0 : 0.0);
       rows.push_back(tr.direction[i] < 0 ? 1.0 : 0.0);
-      rows.push_back(rec[i].speed_rev_s);
+      rows.push_back(rec[i].speed_rev_per_s);
       y.push_back(rec[i].force_internal_kN - rec[i].force_external_kN);
     }
     const auto n = static_cast<Eigen::Index>(y.size());
@@ -117,8 +117,8 @@ TEST(Effects, ViscousFrictionWidensTheLoopWithSpeed) {
   EXPECT_NEAR(on(1), -1.0, 0.08);
   // Seen as loop width: fast samples have a wider loop than slow ones.
   const Rec rec = with(e);
-  const Loop fast = loop(rec, [](const auto& s) { return std::abs(s.speed_rev_s) > 5.0; });
-  const Loop slow = loop(rec, [](const auto& s) { return std::abs(s.speed_rev_s) < 3.0; });
+  const Loop fast = loop(rec, [](const auto& s) { return std::abs(s.speed_rev_per_s) > 5.0; });
+  const Loop slow = loop(rec, [](const auto& s) { return std::abs(s.speed_rev_per_s) < 3.0; });
   EXPECT_GT(fast.half_width() - slow.half_width(), 0.1 * 2.5);
 }
 

@@ -20,7 +20,7 @@ const char* kUsage =
     "                     [--time COL] [--position COL] [--force COL] [--truth COL] [--speed COL]\n"
     "                     [--temperature COL] [--allow-unsorted-time]\n"
     "  Runs the calibrator over a recording. Default columns: time_s, position_rev,\n"
-    "  force_internal_kN; truth: force_external_kN, speed: speed_rev_s and temperature: temperature_C when present.\n"
+    "  force_internal_kN; truth: force_external_kN, speed: speed_rev_per_s (or the older speed_rev_s) and temperature: temperature_C when present.\n"
     "  Time must increase strictly; --allow-unsorted-time drops the lines where it does not and counts them.\n"
     "  Exit: 0 calibrated, 1 an error or no fit accepted (summary.json says why), 2 bad arguments.\n";
 
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
     if (a.truth_given) ro.required.push_back(a.truth_col);
     else ro.optional.push_back("force_external_kN");
     if (a.speed_given) ro.required.push_back(a.speed_col);
-    else ro.optional.push_back("speed_rev_s");
+    else ro.optional.insert(ro.optional.end(), {"speed_rev_per_s", "speed_rev_s"});  // the older spelling too
     if (a.temperature_given) ro.required.push_back(a.temperature_col);
     else ro.optional.push_back("temperature_C");
     ro.time_column = a.time_col;
@@ -116,8 +116,11 @@ int main(int argc, char** argv) {
     rec.position_rev = table.column(a.position_col);
     rec.force_kN = table.column(a.force_col);
     if (!truth_col.empty()) rec.truth_kN = table.column(truth_col);
-    const std::string speed_col = a.speed_given ? a.speed_col : (table.has("speed_rev_s") ? "speed_rev_s" : "");
-    if (!speed_col.empty()) rec.speed_rev_s = table.column(speed_col);
+    const std::string speed_col = a.speed_given                      ? a.speed_col
+                                  : table.has("speed_rev_per_s") ? "speed_rev_per_s"
+                                  : table.has("speed_rev_s")     ? "speed_rev_s"
+                                                                 : "";
+    if (!speed_col.empty()) rec.speed_rev_per_s = table.column(speed_col);
     const std::string temp_col =
         a.temperature_given ? a.temperature_col : (table.has("temperature_C") ? "temperature_C" : "");
     if (!temp_col.empty()) rec.temperature_C = table.column(temp_col);

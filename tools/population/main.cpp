@@ -21,14 +21,14 @@ namespace {
 
 const std::vector<std::string> kColumns = {
     "time_s",       "position_rev",     "force_internal_kN", "force_external_kN", "temperature_C",
-    "speed_rev_s",  "force_true_kN",    "friction_true_kN",  "position_true_rev"};
+    "speed_rev_per_s",  "force_true_kN",    "friction_true_kN",  "position_true_rev"};
 
 int usage(const char* why) {
   if (why) std::fprintf(stderr, "bbw_population: %s\n", why);
   std::fprintf(stderr,
                "usage: bbw_population SPEC.yaml --out DIR [--members FIRST:COUNT]\n"
                "  writes DIR/c<member>_T<temperature>.csv (columns: time_s, position_rev,\n"
-               "  force_internal_kN, force_external_kN, temperature_C, speed_rev_s, force_true_kN,\n"
+               "  force_internal_kN, force_external_kN, temperature_C, speed_rev_per_s, force_true_kN,\n"
                "  friction_true_kN, position_true_rev) and DIR/manifest.json (drawn parameters)\n");
   return 2;
 }
@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
         for (long long k = 0; k < steps; ++k) {
           const auto& s = sim.step(sc.plant_dt_s);
           row = {s.time_s,        s.position_rev,  s.force_internal_kN, s.force_external_kN,  s.temperature_C,
-                 s.speed_rev_s,   s.force_true_kN, s.friction_true_kN,  s.position_true_rev};
+                 s.speed_rev_per_s,   s.force_true_kN, s.friction_true_kN,  s.position_true_rev};
           w.row(row);
         }
         w.close();

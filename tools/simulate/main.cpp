@@ -19,7 +19,7 @@ namespace {
 
 const std::vector<std::string> kColumns = {
     "time_s",        "position_rev",     "force_internal_kN", "force_external_kN", "temperature_C",
-    "speed_rev_s",   "motor_current_A",  "force_true_kN",     "command",           "command_is_force",
+    "speed_rev_per_s",   "motor_current_A",  "force_true_kN",     "command",           "command_is_force",
     "current_command_A", "friction_true_kN", "position_true_rev"};
 
 int usage(const char* why) {
@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
         const auto& s = sim.step(sc.plant_dt_s);
         row = {s.time_s,           s.position_rev,
                s.force_internal_kN, s.force_external_kN,
-               s.temperature_C,    s.speed_rev_s,
+               s.temperature_C,    s.speed_rev_per_s,
                s.motor_current_A,  s.force_true_kN,
                s.command,          s.command_kind == bbw::scenario::CommandKind::Force ? 1.0 : 0.0,
                s.current_command_A, s.friction_true_kN,

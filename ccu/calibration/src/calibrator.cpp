@@ -354,7 +354,7 @@ double Calibrator::speed_now(const Sample& s) {
   vel_t_s_[vel_head_] = s.time_s;
   vel_x_rev_[vel_head_] = s.position_rev;
   if (vel_count_ < w) ++vel_count_;
-  if (std::isfinite(s.speed_rev_s)) return s.speed_rev_s;
+  if (std::isfinite(s.speed_rev_per_s)) return s.speed_rev_per_s;
   if (vel_count_ < 2) return 0.0;
   double tm = 0.0, xm = 0.0;
   for (std::size_t k = 0; k < vel_count_; ++k) {
@@ -444,7 +444,7 @@ Estimate Calibrator::update(const Sample& s) {
   }
   if (e_ > 0) {
     // Delayed: the speed is the slope of the delayed positions (the sample's speed is current).
-    const Sample at_x{s.time_s, x, f_c, delayed ? std::numeric_limits<double>::quiet_NaN() : s.speed_rev_s};
+    const Sample at_x{s.time_s, x, f_c, delayed ? std::numeric_limits<double>::quiet_NaN() : s.speed_rev_per_s};
     n_now_[static_cast<std::size_t>(m_)] = speed_now(at_x) / config_.viscous_speed_scale_rev_per_s;
   }
   double f_fric = 0.0;

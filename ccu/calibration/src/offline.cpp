@@ -29,7 +29,7 @@ Score score_estimates(const Recording& rec, const std::vector<Estimate>& est, do
 
 OfflineResult run_recording(const CalibratorConfig& config, const Recording& rec) {
   const std::size_t n = rec.time_s.size();
-  if (rec.position_rev.size() != n || rec.force_kN.size() != n || (!rec.speed_rev_s.empty() && rec.speed_rev_s.size() != n) ||
+  if (rec.position_rev.size() != n || rec.force_kN.size() != n || (!rec.speed_rev_per_s.empty() && rec.speed_rev_per_s.size() != n) ||
       (!rec.temperature_C.empty() && rec.temperature_C.size() != n)) {
     throw std::invalid_argument("run_recording: the recording's columns differ in length");
   }
@@ -38,7 +38,7 @@ OfflineResult run_recording(const CalibratorConfig& config, const Recording& rec
   out.estimates.reserve(rec.time_s.size());
   for (std::size_t k = 0; k < rec.time_s.size(); ++k) {
     Sample s{rec.time_s[k], rec.position_rev[k], rec.force_kN[k]};
-    if (!rec.speed_rev_s.empty()) s.speed_rev_s = rec.speed_rev_s[k];
+    if (!rec.speed_rev_per_s.empty()) s.speed_rev_per_s = rec.speed_rev_per_s[k];
     if (!rec.temperature_C.empty()) s.temperature_C = rec.temperature_C[k];
     out.estimates.push_back(cal.update(s));
   }

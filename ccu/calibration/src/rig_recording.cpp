@@ -14,14 +14,14 @@ Recording record_corner(const bbw::scenario::Scenario& scenario, std::size_t cor
   rec.position_rev.reserve(steps);
   rec.force_kN.reserve(steps);
   rec.truth_kN.reserve(steps);
-  rec.speed_rev_s.reserve(steps);
+  rec.speed_rev_per_s.reserve(steps);
   for (std::size_t k = 0; k < steps; ++k) {
     const auto& s = sim.step(scenario.plant_dt_s);
     rec.time_s.push_back(s.time_s);
     rec.position_rev.push_back(s.position_rev);
     rec.force_kN.push_back(s.force_internal_kN);
     rec.truth_kN.push_back(s.force_external_kN);
-    rec.speed_rev_s.push_back(s.speed_rev_s);
+    rec.speed_rev_per_s.push_back(s.speed_rev_per_s);
   }
   return rec;
 }

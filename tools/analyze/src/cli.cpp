@@ -14,7 +14,7 @@ std::string usage() {
          "         [--temperature COL|none] [--velocity COL] [--acceleration COL]\n"
          "         [--channels A,B,...|none] [--allow-unsorted-time] [--calibrator FILE.yaml|none]\n"
          "defaults: time_s (or t_s), position_rev, force_internal_kN, truth force_external_kN and\n"
-         "temperature temperature_C and velocity speed_rev_s when present; channels: every other\n"
+         "temperature temperature_C and velocity speed_rev_per_s when present; channels: every other\n"
          "column of the header except those whose name contains 'true' (simulator ground truth).\n"
          "Time must increase strictly; --allow-unsorted-time drops the lines where it does not\n"
          "and counts them.\n"
@@ -94,7 +94,9 @@ LoadedRecording load_recording(const CliArgs& a) {
   };
   L.truth_col = optional_default(a.truth_col, "force_external_kN");
   L.temperature_col = optional_default(a.temperature_col, "temperature_C");
-  L.velocity_col = optional_default(a.velocity_col, "speed_rev_s");
+  // Recordings written before the unit's one spelling (speed_rev_per_s) call it speed_rev_s.
+  L.velocity_col = optional_default(a.velocity_col, "speed_rev_per_s");
+  if (L.velocity_col.empty() && a.velocity_col.empty()) L.velocity_col = optional_default("", "speed_rev_s");
   L.acceleration_col = optional_default(a.acceleration_col, "");
 
   std::vector<std::string> used = {L.time_col, L.position_col, L.force_col, L.truth_col, L.temperature_col,

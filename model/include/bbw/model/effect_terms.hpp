@@ -60,7 +60,7 @@ struct ViscousTerm {
     return detail::check(speed_scale, v.viscous_speed_scale_rev_per_s);
   }
   static int columns(const EffectTermValues& v) { return v.viscous ? 1 : 0; }
-  static double friction_kN(double c_v, double speed_rev_s) { return c_v * speed_rev_s; }
+  static double friction_kN(double c_v, double speed_rev_per_s) { return c_v * speed_rev_per_s; }
 };
 
 // The load cell lags the resolver by d: the model runs on the position d earlier (calibrator only;

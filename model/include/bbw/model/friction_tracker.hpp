@@ -39,7 +39,7 @@ class FrictionTracker {
   bool started() const { return started_; }
   // Friction (kN) the load cell holds at resolver position x and speed v; the model's sizes
   // must match reset()'s.
-  double step(const FrictionModel& m, double x_rev, double speed_rev_s) {
+  double step(const FrictionModel& m, double x_rev, double speed_rev_per_s) {
     const double x = BacklashTerm::on(m.backlash_width_rev)
                          ? BacklashTerm::spindle_rev(spindle_rev_, x_rev, m.backlash_width_rev)
                          : x_rev;
@@ -48,13 +48,13 @@ class FrictionTracker {
     if (LoadFrictionTerm::on(m.load_gain)) {
       f *= LoadFrictionTerm::scale(m.load_gain, m.load_reference_kN, m.curve.force_kN(x));
     }
-    return f + ViscousTerm::friction_kN(m.viscous_kN_per_rev_per_s, speed_rev_s);
+    return f + ViscousTerm::friction_kN(m.viscous_kN_per_rev_per_s, speed_rev_per_s);
   }
   // What the load cell reads beyond the clamp force at temperature T: the friction above plus
   // the thermal zero offset, as the calibrator removes it (a non-finite T: the last finite one;
   // none yet: no offset).
-  double step_load_cell_excess(const FrictionModel& m, double x_rev, double speed_rev_s, double temperature_C) {
-    const double f = step(m, x_rev, speed_rev_s);
+  double step_load_cell_excess(const FrictionModel& m, double x_rev, double speed_rev_per_s, double temperature_C) {
+    const double f = step(m, x_rev, speed_rev_per_s);
     if (std::isfinite(temperature_C)) {
       temperature_C_ = temperature_C;
       have_temperature_ = true;

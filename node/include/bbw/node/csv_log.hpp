@@ -17,7 +17,7 @@
 namespace bbw::node {
 
 inline constexpr const char* kCcuCsvHeader =
-    "time_s,seq,block_seq,position_rev,speed_rev_s,force_internal_kN,force_external_kN,force_true_kN,"
+    "time_s,seq,block_seq,position_rev,speed_rev_per_s,force_internal_kN,force_external_kN,force_true_kN,"
     "temperature_C,motor_current_A,command,force_mode,estimate_kN,friction_kN,curve_kN,fused_kN,valid,"
     "calibrated,source,available,accepted\n";
 
@@ -75,7 +75,7 @@ class CcuCsvLog final : public CcuObserver {
     put(s.time_s());
     put_u(s.seq());
     put_u(block_seq);
-    for (double v : {s.position_rev(), s.speed_rev_s(), s.force_internal_kN(), s.force_external_kN(),
+    for (double v : {s.position_rev(), s.speed_rev_per_s(), s.force_internal_kN(), s.force_external_kN(),
                      s.force_true_kN(), s.temperature_C(), s.motor_current_A(), s.command()}) {
       put(v);
     }

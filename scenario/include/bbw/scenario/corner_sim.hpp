@@ -24,7 +24,7 @@ struct CornerSample {
   std::uint64_t seq = 0;            // 1 for the first step
   double time_s = 0.0;
   double position_rev = 0.0;        // resolver
-  double speed_rev_s = 0.0;         // resolver speed
+  double speed_rev_per_s = 0.0;         // resolver speed
   double force_internal_kN = 0.0;   // load cell
   double force_external_kN = 0.0;   // external (test rig) force sensor
   double force_true_kN = 0.0;       // truth

@@ -23,7 +23,7 @@ struct Sample {
   double time_s = 0.0;
   double position_rev = 0.0;  // resolver position, actuator revolutions
   double force_kN = 0.0;      // internal load-cell reading (true force + key friction)
-  double speed_rev_s = std::numeric_limits<double>::quiet_NaN();  // resolver speed; NaN = not given
+  double speed_rev_per_s = std::numeric_limits<double>::quiet_NaN();  // resolver speed; NaN = not given
   double temperature_C = std::numeric_limits<double>::quiet_NaN();  // caliper temperature; NaN = not given
 };
 

@@ -13,7 +13,7 @@ struct Recording {
   std::vector<double> position_rev;
   std::vector<double> force_kN;   // internal load cell
   std::vector<double> truth_kN;   // external sensor / true clamp force; empty when absent
-  std::vector<double> speed_rev_s;  // resolver speed; empty when absent
+  std::vector<double> speed_rev_per_s;  // resolver speed; empty when absent
   std::vector<double> temperature_C;  // caliper temperature; empty when absent
 };
 
