@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <stdexcept>
 
 #include "bbw/dds/run_id.hpp"
@@ -19,10 +20,21 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-dds::ParticipantOptions named(dds::ParticipantOptions p) {
-  if (p.name.empty()) p.name = "bbw_ccu";
+dds::ParticipantOptions named(dds::ParticipantOptions p, const CcuOptions& o) {
+  if (p.name.empty()) p.name = o.standby && o.role == "standby" ? "bbw_ccu_standby" : "bbw_ccu";
   return p;
 }
+
+// A standby run's lockstep re-send interval: the corners' command deadline (10 ms), so the
+// standby's grant reaches a corner soon after the corner dropped a silent primary.
+constexpr auto kStandbyResend = std::chrono::milliseconds(10);
+// A CCU whose own commands were this far apart may have lost the corners' ownership to the other
+// CCU: the command deadline of the *_owned profiles.
+constexpr double kOwnershipDeadline_s = 0.010;
+// A CCU that heard no block from any corner this long is cut off (its link is down): longer than
+// the measurement deadline (15 ms), so one late period of every corner is not a cut.
+constexpr double kCutOff_s = 0.050;
+
 
 // The first period that starts at or after time_s.
 std::uint64_t step_at(double time_s, double period_s) {
@@ -38,7 +50,7 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
       events_(events),
       node_(scenario, calibrator, options.friction_feedback, options.monitor),
       periods_(node_.periods()),
-      participant_(named(options.participant)),
+      participant_(named(options.participant, options)),
       // Calibration state in the run's partition; measurements, health and each corner's commands
       // in that corner's partition of this run (bbw/dds/run_id.hpp): another run on the domain
       // never matches, and a corner is woken only by its own command (not by all four).
@@ -53,15 +65,23 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
         dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_reader, events, partition));
     health_.push_back(std::make_unique<HealthInlet>(participant_, dds::kHealthTopic, "state_reader", events, partition));
     commands_.push_back(std::make_unique<CommandOutlet>(
-        participant_, dds::kCommandTopic, dds::profiles_for(options.mode == ClockMode::Lockstep).command_writer, events,
+        participant_, dds::kCommandTopic, dds::profiles_for(options.mode == ClockMode::Lockstep, options.standby).command_writer, events,
         partition));
   }
   instances_.resize(node_.channels());
+  const faults::Target self = options.standby && options.role == "standby" ? faults::Target::CcuStandby : faults::Target::CCU;
+  if (options.standby) {
+    failover_.role = options.role;
+    failover_.strength_initial = dds::ccu_strength(options.role != "standby", 0);
+    set_strength(failover_.strength_initial);
+  }
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
   if (options.process_faults) {
     for (const faults::ProcessAction& a : faults::process_actions(options.schedule)) {
-      if (a.target == faults::Target::CCU) {
+      if (faults::is_ccu(a.target)) {
+        if (a.target != self) continue;  // the other CCU's
         if (a.kind == faults::ProcessAction::Kind::Kill && !kill_at_s_) kill_at_s_ = a.at_s;
+        if (a.kind == faults::ProcessAction::Kind::Hang && !hang_at_s_) hang_at_s_ = a.at_s;
       } else if (a.kind == faults::ProcessAction::Kind::Restart) {
         restarts_.emplace_back(step_at(a.at_s, scenario.ccu_period_s), *faults::corner_slot(a.target));
       }
@@ -118,6 +138,36 @@ void CcuApp::send_commands(std::uint64_t step, bool stop, bool log) {
   for (std::size_t i = 0; i < cmds.size(); ++i) commands_[i]->send(cmds[i]);
 }
 
+void CcuApp::set_strength(std::uint32_t strength) {
+  for (auto& c : commands_) {
+    auto& w = c->get().get();
+    eprosima::fastdds::dds::DataWriterQos q = w.get_qos();
+    q.ownership_strength().value = strength;
+    if (w.set_qos(q) != ReturnCode_t::RETCODE_OK) {
+      throw dds::DdsError("cannot set the command writer's ownership strength to " + std::to_string(strength));
+    }
+  }
+  failover_.strength_final = strength;
+}
+
+void CcuApp::demote(double sim_s, const char* reason) {
+  if (!options_.standby) return;
+  ++failover_.outages;
+  set_strength(dds::ccu_strength(options_.role != "standby", failover_.outages));
+  failover_.demoted_sim_s = sim_s;
+  failover_.demoted_mono_s = runtime::mono_now_s();
+  failover_.demote_reason = reason;
+  std::cout << "bbw_ccu (" << options_.role << "): lowered its command strength to " << failover_.strength_final
+            << " at " << sim_s << " s (" << reason << ")" << std::endl;
+}
+
+void CcuApp::write_failover_stats() const {
+  if (!options_.standby || options_.out_dir.empty()) return;
+  runtime::CcuFailoverStats s = failover_;
+  s.periods_done = periods_done_;
+  runtime::save(s, options_.out_dir + "/ccu_failover.stats");
+}
+
 void CcuApp::send_calibration_updates() {
   for (const msg::CalibrationState* s : node_.calibration_updates()) calibration_.send(*s);
   node_.clear_calibration_updates();
@@ -128,6 +178,8 @@ void CcuApp::drain_blocks(double arrival_s) {
   transport::EndpointId writer = 0;
   for (std::size_t i = 0; i < node_.channels(); ++i) {
     while (blocks_[i]->take(block_, writer)) {
+      last_block_at_ = Clock::now();
+      cut_off_ = false;
       if (block_.corner_id() == node_.channel(i).slot) instances_[i] = blocks_[i]->last_info().instance_handle;
       node_.on_block(i, block_, writer, realtime ? realtime_now_s() : arrival_s);
       send_calibration_updates();
@@ -178,9 +230,27 @@ void CcuApp::freeze_for_kill(double at_s) {
   wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
   if (log_ != nullptr) log_->flush();
   if (!options_.out_dir.empty()) write_stats(options_.out_dir + "/ccu.stats");
+  failover_.failure = "kill";
+  failover_.failed_sim_s = at_s;
+  failover_.failed_mono_s = runtime::mono_now_s();
+  write_failover_stats();
   ::raise(SIGSTOP);
   // Continued instead of killed (nobody carried the kill out): stop without a word.
   ::_exit(kExitRuntime);
+}
+
+void CcuApp::freeze_for_hang(double at_s) {
+  // The scheduled hang (a standby run): stop dead like a kill, but the launcher leaves the
+  // process stopped (and continues it after resume_after_s, if given).
+  hang_at_s_.reset();
+  if (log_ != nullptr) log_->flush();
+  failover_.failure = "hang";
+  failover_.failed_sim_s = at_s;
+  failover_.failed_mono_s = runtime::mono_now_s();
+  write_failover_stats();
+  ::raise(SIGSTOP);
+  failover_.resumed_mono_s = runtime::mono_now_s();
+  demote(at_s, "resumed after a stop");
 }
 
 int CcuApp::run(std::string& error) {
@@ -190,11 +260,21 @@ int CcuApp::run(std::string& error) {
   const double T = scenario_.ccu_period_s;
   t0_ = Clock::now();
   int rc = kExitOk;
+  bool retired = false;
   std::uint32_t expected_incarnation[kSlots] = {};
   if (options_.mode == ClockMode::Lockstep) {
     for (std::uint64_t k = 0; k < periods_ && !events_.interrupted(); ++k) {
       const double t_k = node_.period_start_s(k);
       if (kill_at_s_ && t_k >= *kill_at_s_ - 1e-9) freeze_for_kill(t_k);
+      if (hang_at_s_ && t_k >= *hang_at_s_ - 1e-9) {
+        freeze_for_hang(t_k);
+        // A lockstep CCU cannot rejoin the lock step after a stop (the corners went on under the
+        // other CCU; the blocks it missed are gone): it leaves the run.
+        std::cout << "bbw_ccu (" << options_.role << "): resumed after a hang in lockstep: leaves the run at " << t_k
+                  << " s" << std::endl;
+        retired = true;
+        break;
+      }
       for (const auto& [step, slot] : restarts_) {
         if (step != k) continue;
         for (std::size_t i = 0; i < node_.channels(); ++i) {
@@ -213,9 +293,10 @@ int CcuApp::run(std::string& error) {
         return node_.period_complete(k);
       };
       const auto give_up = Clock::now() + options_.peer_timeout;
+      const auto resend = options_.standby ? Clock::duration(kStandbyResend) : Clock::duration(std::chrono::milliseconds(200));
       bool ok = false;
       for (;;) {
-        ok = events_.wait_until(std::min(give_up, Clock::now() + std::chrono::milliseconds(200)), pred);
+        ok = events_.wait_until(std::min(give_up, Clock::now() + resend), pred);
         if (ok || events_.interrupted() || Clock::now() >= give_up) break;
         send_commands(k, false, false);
       }
@@ -253,6 +334,30 @@ int CcuApp::run(std::string& error) {
       periods_done_ = k;
       if (k == periods_) break;
       if (kill_at_s_ && t_k >= *kill_at_s_ - 1e-9) freeze_for_kill(t_k);
+      if (hang_at_s_ && t_k >= *hang_at_s_ - 1e-9) {
+        freeze_for_hang(t_k);
+        // Resumed: go on from the period the wall clock is in (the missed ones are gone).
+        k = std::max(k, static_cast<std::uint64_t>(realtime_now_s() / T));
+        if (k >= periods_) break;
+        last_send_ = {};
+        last_block_at_ = Clock::now();
+        continue;
+      }
+      if (options_.standby) {
+        // Out of the loop long enough for the corners to drop this CCU as their owner: stalled
+        // (its own commands too far apart), or cut off (no block from any corner). It then lets
+        // the other CCU keep the corners (docs/faults.md, "Hand-back").
+        const auto now = Clock::now();
+        const double send_gap_s = std::chrono::duration<double>(now - last_send_).count();
+        const double quiet_s = std::chrono::duration<double>(now - last_block_at_).count();
+        if (last_send_ != Clock::time_point{} && send_gap_s > kOwnershipDeadline_s) demote(t_k, "stalled");
+        if (last_block_at_ != Clock::time_point{} && quiet_s > kCutOff_s && k + 4 < periods_ && !cut_off_) {
+          demote(t_k, "cut off from every corner");
+          cut_off_ = true;  // one outage until a block arrives again
+        }
+        // The gap to the next send starts now: the demotion's own time (set_qos) is not a stall.
+        last_send_ = Clock::now();
+      }
       send_commands(k, false);
     }
     // The last blocks: wait briefly for every corner that is still linked.
@@ -265,6 +370,11 @@ int CcuApp::run(std::string& error) {
   }
   wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
   sim_s_ = static_cast<double>(periods_done_) * T;
+  write_failover_stats();
+  if (retired) {
+    if (log_ != nullptr) log_->flush();
+    return rc;
+  }
   send_commands(periods_, true);
   for (auto& c : commands_) c->get().get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
   if (log_ != nullptr) log_->flush();

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bbw/calibration/calibrator.hpp"
+#include "bbw/runtime/failover_stats.hpp"
 #include "bbw/runtime/process_cli.hpp"
 #include "bbw/dds/corner.hpp"
 #include "bbw/dds/events.hpp"
@@ -47,6 +48,10 @@ struct CcuOptions : runtime::ProcessOptions {
   bool friction_feedback = true;                  // let corners use compensated feedback
   faults::MonitorParams monitor;                  // config/faults/monitor.yaml (--monitor)
   faults::FaultSchedule schedule;
+  // With a hot-standby CCU (options.standby, issue 16): "primary" or "standby" (--role). Sets the
+  // participant name (bbw_ccu / bbw_ccu_standby), the command writers' ownership strength and
+  // which of the schedule's CCU faults (CCU / CCU_STANDBY) is this process's.
+  std::string role = "primary";
 };
 
 class CcuApp {
@@ -69,6 +74,12 @@ class CcuApp {
   void drain_health();
   bool wait_for_rejoin(std::size_t channel, std::uint32_t incarnation, std::string& error);
   [[noreturn]] void freeze_for_kill(double at_s);
+  // The scheduled hang: freezes (SIGSTOP) like a kill; returns when the launcher continues it.
+  void freeze_for_hang(double at_s);
+  // An outage: lowers this CCU's command strength (dds::ccu_strength; docs/faults.md "Hand-back").
+  void demote(double sim_s, const char* reason);
+  void set_strength(std::uint32_t strength);
+  void write_failover_stats() const;
   double realtime_now_s() const;
 
   const scenario::Scenario& scenario_;
@@ -97,6 +108,11 @@ class CcuApp {
   double sim_s_ = 0.0;
   std::uint64_t periods_done_ = 0;
   std::optional<double> kill_at_s_;                       // scheduled CCU kill
+  std::optional<double> hang_at_s_;                       // scheduled CCU hang (a standby run)
+  runtime::CcuFailoverStats failover_;                    // a standby run: role, strength, failure
+  std::chrono::steady_clock::time_point last_send_{};     // realtime, standby run: the last command send
+  std::chrono::steady_clock::time_point last_block_at_{}; // ... and the last block from any corner
+  bool cut_off_ = false;                                  // no block from any corner for kCutOff_s
   std::vector<std::pair<std::uint64_t, std::size_t>> restarts_;  // lockstep: (step, slot)
 };
 

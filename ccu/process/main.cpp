@@ -5,6 +5,11 @@
 //           [--discovery-timeout S] [--peer-timeout S] [--process-faults]
 //           [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--secure KEYS_DIR]
 //           [--out DIR] [--calibrator FILE.yaml] [--monitor FILE.yaml] [--friction-feedback on|off]
+//           [--standby --role primary|standby]
+//
+// --standby --role: one of the two CCUs of a run with a hot-standby CCU (issue 16, docs/faults.md
+// "Hot-standby CCU"): commands under DDS exclusive ownership, the primary stronger; the standby
+// is the participant bbw_ccu_standby (with --secure, identity ccu_standby).
 //
 // The flags in the first three lines are bbw_corner's too (bbw/runtime/process_cli.hpp).
 //
@@ -37,7 +42,8 @@
 namespace {
 
 std::string usage() {
-  return bbw::runtime::process_usage("bbw_ccu", "", {"[--out DIR] [--calibrator FILE.yaml] [--monitor FILE.yaml] [--friction-feedback on|off]"});
+  return bbw::runtime::process_usage("bbw_ccu", "", {"[--out DIR] [--calibrator FILE.yaml] [--monitor FILE.yaml] [--friction-feedback on|off]",
+                                                  "[--role primary|standby] (with --standby)"});
 }
 
 }  // namespace
@@ -51,6 +57,7 @@ int main(int argc, char** argv) {
   bbw::runtime::ProcessFlags flags;
   std::string calibrator_file;  // default: config/calibrator/robust.yaml of bbw's data (bbw/common/data_path.hpp)
   std::string monitor_file;     // default: config/faults/monitor.yaml
+  bool role_given = false;
   try {
     for (bbw::runtime::ArgCursor args(argc, argv); !args.done();) {
       const std::string k = args.flag();
@@ -58,6 +65,13 @@ int main(int argc, char** argv) {
       if (k == "--out") opt.out_dir = args.value();
       else if (k == "--calibrator") calibrator_file = args.value();
       else if (k == "--monitor") monitor_file = args.value();
+      else if (k == "--role") {
+        opt.role = args.value();
+        if (opt.role != "primary" && opt.role != "standby") {
+          throw std::invalid_argument("--role must be primary or standby, got '" + opt.role + "'");
+        }
+        role_given = true;
+      }
       else if (k == "--friction-feedback") {
         const std::string v = args.value();
         if (v != "on" && v != "off") throw std::invalid_argument("--friction-feedback must be on or off, got '" + v + "'");
@@ -67,6 +81,7 @@ int main(int argc, char** argv) {
       else throw std::invalid_argument("unknown argument '" + k + "'");
     }
     flags.finish(std::getenv("BBW_DOMAIN"));
+    if (role_given && !flags.options.standby) throw std::invalid_argument("--role needs --standby (a run with a hot-standby CCU)");
   } catch (const std::exception& e) {
     std::cerr << "bbw_ccu: " << e.what() << "\n" << usage();
     return kExitUsage;

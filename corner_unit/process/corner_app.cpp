@@ -31,6 +31,7 @@ node::CornerNodeOptions node_options(const CornerOptions& o) {
   n.incarnation = o.incarnation;
   n.resume_at_s = o.resume_at_s;
   n.run_id = o.participant.run_id;
+  n.standby = o.standby;
   return n;
 }
 
@@ -64,10 +65,11 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       // sample and made the CCU's command writes its largest cost. The node drops the other
       // corners' samples instead (4 commands per period, a few bytes each).
       commands_(participant_, dds::kCommandTopic,
-                dds::profiles_for(options.mode == ClockMode::Lockstep).command_reader, events,
+                dds::profiles_for(options.mode == ClockMode::Lockstep, options.standby).command_reader, events,
                 dds::Partition{own_partition(options)}),
       calibration_(participant_, dds::kCalibrationTopic, "state_reader", events,
-                   dds::Partition{dds::run_partition(options.participant.run_id)}) {
+                   dds::Partition{dds::run_partition(options.participant.run_id)}),
+      owners_(scenario.ccu_period_s) {
   if (!options.periods_log.empty()) {
     periods_log_ = std::make_unique<node::CornerPeriodsLog>(options.periods_log, options.incarnation);
     node_.set_observer(periods_log_.get());
@@ -80,8 +82,9 @@ void CornerApp::publish_health(std::uint8_t status) { health_.send(node_.health(
 
 bool CornerApp::wait_for_ccu(std::string& error) {
   const auto timeout = options_.match_timeout.count() > 0 ? options_.match_timeout : options_.discovery_timeout;
+  const int ccus = options_.standby ? 2 : 1;  // a hot-standby run: both CCUs before the start
   const bool ok = events_.wait_for(timeout, [&] {
-    return blocks_.peers() >= 1 && commands_.peers() >= 1 && calibration_.peers() >= 1 && health_.peers() >= 1;
+    return blocks_.peers() >= ccus && commands_.peers() >= ccus && calibration_.peers() >= ccus && health_.peers() >= ccus;
   });
   matched_ccu_ = ok;
   if (!ok && !events_.interrupted()) {
@@ -108,9 +111,25 @@ corner::CommandSource CornerApp::command_source() const {
     std::array<std::uint8_t, 12> prefix{};
     std::copy_n(source.writer.begin(), prefix.size(), prefix.begin());
     const auto tag = participant_.peer_tag(prefix);
-    source.announced_as_ccu = tag && tag->run_id == participant_.run_id() && tag->name == "bbw_ccu";
+    source.announced_as_ccu = tag && tag->run_id == participant_.run_id() &&
+                              (tag->name == "bbw_ccu" || (options_.standby && tag->name == "bbw_ccu_standby"));
   }
   return source;
+}
+
+// The role of a command's writer, from its participant's announced name (cached per writer).
+runtime::CommandRole CornerApp::command_role(const std::array<std::uint8_t, 16>& writer) {
+  if (have_role_ && writer == role_writer_) return role_;
+  std::array<std::uint8_t, 12> prefix{};
+  std::copy_n(writer.begin(), prefix.size(), prefix.begin());
+  const auto tag = participant_.peer_tag(prefix);
+  role_ = !tag ? runtime::CommandRole::Unknown
+        : tag->name == "bbw_ccu" ? runtime::CommandRole::Primary
+        : tag->name == "bbw_ccu_standby" ? runtime::CommandRole::Standby
+                                         : runtime::CommandRole::Unknown;
+  role_writer_ = writer;
+  have_role_ = true;
+  return role_;
 }
 
 bool CornerApp::ccu_gone() const {
@@ -123,7 +142,12 @@ void CornerApp::drain_inputs() {
   transport::EndpointId from = 0;
   while (commands_.take(command_in_, from)) {
     if (command_in_.corner_id() != dds::corner_index(options_.corner)) continue;  // another corner's
-    node_.on_command(command_in_, command_source(), started_ ? sim_now_s() : 0.0);
+    const corner::CommandSource source = command_source();
+    const std::uint64_t accepted_before = node_.stats().commands_received;
+    node_.on_command(command_in_, source, started_ ? sim_now_s() : 0.0);
+    if (options_.standby && node_.stats().commands_received != accepted_before) {
+      owners_.on_command(command_role(source.writer), command_in_.step(), command_in_.time_s(), runtime::mono_now_s());
+    }
   }
   while (calibration_.take(state_in_)) node_.on_calibration(state_in_);
 }
@@ -141,6 +165,19 @@ void CornerApp::finish_stats(Clock::time_point wall0) {
   s.write_failures = failures_before;
   s.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   if (periods_log_ != nullptr) periods_log_->flush();
+  write_failover_stats();
+}
+
+// A hot-standby run: whose commands this corner applied, next to its stats file
+// (corner_FL.stats -> corner_FL_failover.stats).
+void CornerApp::write_failover_stats() const {
+  if (!options_.standby || options_.stats_file.empty()) return;
+  std::string file = options_.stats_file;
+  const std::string ext = ".stats";
+  if (file.size() > ext.size() && file.compare(file.size() - ext.size(), ext.size(), ext) == 0) file.resize(file.size() - ext.size());
+  runtime::CornerFailoverStats s = owners_.stats();
+  s.corner = dds::corner_name(options_.corner);
+  runtime::save(s, file + "_failover.stats");
 }
 
 void CornerApp::freeze_for_kill() {

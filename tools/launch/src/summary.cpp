@@ -102,6 +102,7 @@ std::string tracking_not_scored_reason(const CornerSummary& s) {
 
 #include "bbw/common/json.hpp"
 #include "bbw/runtime/run_stats.hpp"
+#include "failover_summary.hpp"
 #include "fault_report.hpp"
 #include "partial_summary.hpp"
 #include "report.hpp"
@@ -122,7 +123,8 @@ std::string corner_stats_file(const std::string& out_dir, const std::string& cor
 RunTotals write_run_summary(const CompletedRun& run) {
   const scenario::Scenario& scenario = *run.scenario;
   const std::string& out_dir = run.out_dir;
-  const std::string ccu_stats_file = out_dir + "/ccu.stats";
+  const std::string& ccu_dir = run.ccu_dir.empty() ? out_dir : run.ccu_dir;
+  const std::string ccu_stats_file = ccu_dir + "/ccu.stats";
   const runtime::CcuRunStats ccu = runtime::load_ccu_stats(ccu_stats_file);
   auto incarnations_of = [&](const std::string& c) {
     const auto it = run.incarnations.find(c);
@@ -177,7 +179,7 @@ RunTotals write_run_summary(const CompletedRun& run) {
     };
     using CS = runtime::CornerRunStats;
     const runtime::CcuCornerStats& at_ccu = ccu.corner(c.name, ccu_stats_file);
-    const auto table = csv::read(out_dir + "/ccu_" + c.name + ".csv", ccu_log_columns());
+    const auto table = csv::read(ccu_dir + "/ccu_" + c.name + ".csv", ccu_log_columns());
     const auto m = summarize_corner(c.name, table);
     const long long pub = static_cast<long long>(corner_sum(&CS::samples_published));
     // Not receivable: still held back by an injected delay, or sent after the CCU died.
@@ -317,6 +319,22 @@ RunTotals write_run_summary(const CompletedRun& run) {
         .end_object();
   }
   j.end_array();
+  if (run.standby) {
+    FailoverInput in;
+    in.scenario = &scenario;
+    in.lockstep = run.mode == "lockstep";
+    in.primary = runtime::load_ccu_failover(out_dir + "/ccu_failover.stats");
+    in.standby = runtime::load_ccu_failover(out_dir + "/standby/ccu_failover.stats");
+    for (std::size_t i = 0; i < scenario.corners.size(); ++i) {
+      const std::string& c = scenario.corners[i].name;
+      FailoverCornerInput ci;
+      ci.owners = runtime::load_corner_failover(out_dir + "/corner_" + c + "_failover.stats");
+      ci.ccu_lost_s = ccu_lost_s[c];
+      ci.periods = period_logs[i];
+      in.corners.push_back(std::move(ci));
+    }
+    write_failover(j, assess_failover(in));
+  }
   j.end_object();
   j.save(out_dir + "/summary.json");
   {

@@ -1,6 +1,8 @@
 // Topic names and the QoS profile names each role uses, in one place.
 #pragma once
 
+#include <cstdint>
+
 namespace bbw::dds {
 
 inline constexpr const char* kMeasurementTopic = "bbw/MeasurementBlock";
@@ -25,6 +27,29 @@ constexpr ProfileNames profiles_for(bool lockstep) {
   }
   return {"measurement_writer_realtime", "measurement_reader_realtime", "command_writer_realtime",
           "command_reader_realtime"};
+}
+
+// With a hot-standby CCU (issue 16): the same, with the commands under EXCLUSIVE ownership,
+// KEEP_LAST 1 and a 10 ms deadline (config/dds/bbw_profiles.xml).
+constexpr ProfileNames profiles_for(bool lockstep, bool standby) {
+  ProfileNames p = profiles_for(lockstep);
+  if (standby) {
+    p.command_writer = lockstep ? "command_writer_lockstep_owned" : "command_writer_realtime_owned";
+    p.command_reader = lockstep ? "command_reader_lockstep_owned" : "command_reader_realtime_owned";
+  }
+  return p;
+}
+
+// Ownership strength of a CCU's command writers (issue 16, docs/faults.md "Hand-back"): the CCU
+// with fewer outages leads, the primary at equal counts. An outage is anything after which the
+// corners may have dropped this CCU (stopped and continued, a stall beyond the command deadline,
+// cut off from every corner); strength only falls, so a returning CCU never takes the corners
+// back from one that stayed, and an outage both CCUs share (a machine stall) changes nothing.
+inline constexpr std::uint32_t kStrengthBase = 1000000;
+inline constexpr std::uint32_t kStrengthPerOutage = 10;
+constexpr std::uint32_t ccu_strength(bool primary, std::uint32_t outages) {
+  const std::uint32_t lost = outages >= kStrengthBase / kStrengthPerOutage ? kStrengthBase - 10 : kStrengthPerOutage * outages;
+  return kStrengthBase - lost + (primary ? 1u : 0u);
 }
 
 }  // namespace bbw::dds

@@ -12,6 +12,7 @@
 
 #include <bbw/idl/bbw_msgs.h>
 
+#include <array>
 #include <cstdint>
 #include <optional>
 
@@ -40,6 +41,10 @@ struct CornerNodeOptions {
   // The run this corner belongs to (bbw_launch's run id; 0 in process): stamped on every block and
   // health message; commands and calibration states of another run are refused.
   std::uint64_t run_id = 0;
+  // A run with a hot-standby CCU (issue 16): the gate pins both CCUs' command writers, and in
+  // realtime a command from another writer than the last one (a takeover: DDS ownership chose
+  // it) is taken even if its period number is lower (the two CCUs' clocks start apart).
+  bool standby = false;
 };
 
 struct CornerStats {
@@ -153,6 +158,7 @@ class CornerNode {
   msg::ClampCommand latest_command_;
   bool have_command_ = false;
   std::optional<std::uint64_t> last_command_seq_;
+  std::array<std::uint8_t, 16> last_writer_{};  // of the newest command taken
   dds::CalibrationModel model_;
   dds::CalibrationModel candidate_;
   calibration::FrictionTracker friction_;  // element and play states of the CCU's friction model
