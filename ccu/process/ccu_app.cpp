@@ -62,13 +62,19 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
         security::corner_partition(static_cast<int>(node_.channel(i).slot)), options.participant.run_id)};
     blocks_.push_back(std::make_unique<BlockInlet>(
         participant_, dds::kMeasurementTopic,
-        dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_reader, events, partition));
+        dds::profiles_for(options.mode == ClockMode::Lockstep, options.standby).measurement_reader, events, partition));
     health_.push_back(std::make_unique<HealthInlet>(participant_, dds::kHealthTopic, "state_reader", events, partition));
     commands_.push_back(std::make_unique<CommandOutlet>(
         participant_, dds::kCommandTopic, dds::profiles_for(options.mode == ClockMode::Lockstep, options.standby).command_writer, events,
         partition));
   }
   instances_.resize(node_.channels());
+  if (options.standby && options.mode == ClockMode::Lockstep) {
+    stash_.resize(node_.channels());
+    for (Stash& s : stash_) {
+      for (Stash::Slot& slot : s.slots) slot.block.samples().reserve(msg::MAX_BLOCK_SAMPLES);
+    }
+  }
   const faults::Target self = options.standby && options.role == "standby" ? faults::Target::CcuStandby : faults::Target::CCU;
   if (options.standby) {
     failover_.role = options.role;
@@ -173,9 +179,13 @@ void CcuApp::send_calibration_updates() {
   node_.clear_calibration_updates();
 }
 
-void CcuApp::drain_blocks(double arrival_s) {
+void CcuApp::drain_blocks(double arrival_s, std::optional<std::uint64_t> step) {
   const bool realtime = options_.mode == ClockMode::Realtime;
   transport::EndpointId writer = 0;
+  if (step && options_.standby) {
+    drain_blocks_in_order(arrival_s, *step);
+    return;
+  }
   for (std::size_t i = 0; i < node_.channels(); ++i) {
     while (blocks_[i]->take(block_, writer)) {
       last_block_at_ = Clock::now();
@@ -183,6 +193,42 @@ void CcuApp::drain_blocks(double arrival_s) {
       if (block_.corner_id() == node_.channel(i).slot) instances_[i] = blocks_[i]->last_info().instance_handle;
       node_.on_block(i, block_, writer, realtime ? realtime_now_s() : arrival_s);
       send_calibration_updates();
+    }
+  }
+}
+
+// Lockstep with a hot-standby CCU: the corners follow the grants of whichever CCU owns their
+// commands, so this CCU may be behind them (it started later, or it is slower) and find blocks
+// of later periods waiting. It takes them into the node in period order, each in its own period:
+// the two CCUs then compute the same thing from the same blocks whoever leads. The blocks of
+// later periods wait in a stash sized at construction.
+void CcuApp::drain_blocks_in_order(double arrival_s, std::uint64_t step) {
+  for (std::size_t i = 0; i < node_.channels(); ++i) {
+    Stash& s = stash_[i];
+    auto process = [&](const msg::MeasurementBlock& b, transport::EndpointId writer) {
+      last_block_at_ = Clock::now();
+      cut_off_ = false;
+      node_.on_block(i, b, writer, arrival_s);
+      send_calibration_updates();
+    };
+    while (s.count > 0 && s.slots[s.head].block.block_seq() <= step) {
+      process(s.slots[s.head].block, s.slots[s.head].writer);
+      s.head = (s.head + 1) % s.slots.size();
+      --s.count;
+    }
+    transport::EndpointId writer = 0;
+    while (blocks_[i]->take(block_, writer)) {
+      if (block_.corner_id() == node_.channel(i).slot) instances_[i] = blocks_[i]->last_info().instance_handle;
+      if (block_.block_seq() <= step && s.count == 0) {
+        process(block_, writer);
+      } else if (s.count < s.slots.size()) {
+        Stash::Slot& slot = s.slots[(s.head + s.count) % s.slots.size()];
+        slot.block = block_;
+        slot.writer = writer;
+        ++s.count;
+      } else {
+        ++stash_overflows_;  // further behind than the stash holds: the block is lost to this CCU
+      }
     }
   }
 }
@@ -287,7 +333,7 @@ int CcuApp::run(std::string& error) {
       // A command is re-sent every 200 ms without progress: a corner that has just (re)joined
       // may have matched our writer only after it was sent.
       auto pred = [&] {
-        drain_blocks(t_end);
+        drain_blocks(t_end, k);
         drain_health();
         drain_qos_events(t_end, true);
         return node_.period_complete(k);
@@ -371,6 +417,10 @@ int CcuApp::run(std::string& error) {
   wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
   sim_s_ = static_cast<double>(periods_done_) * T;
   write_failover_stats();
+  if (stash_overflows_ > 0) {
+    std::cerr << "bbw_ccu (" << options_.role << "): " << stash_overflows_
+              << " blocks lost: this CCU fell more than 1024 periods behind the corners" << std::endl;
+  }
   if (retired) {
     if (log_ != nullptr) log_->flush();
     return rc;

@@ -69,7 +69,9 @@ class CcuApp {
   bool wait_for_corners(std::string& error);
   void send_commands(std::uint64_t step, bool stop, bool log = true);
   void send_calibration_updates();
-  void drain_blocks(double arrival_s);
+  // `step`: lockstep, the period being waited for (with a standby: blocks go in in period order).
+  void drain_blocks(double arrival_s, std::optional<std::uint64_t> step = std::nullopt);
+  void drain_blocks_in_order(double arrival_s, std::uint64_t step);
   void drain_qos_events(double now_s, bool lockstep);
   void drain_health();
   bool wait_for_rejoin(std::size_t channel, std::uint32_t incarnation, std::string& error);
@@ -113,6 +115,17 @@ class CcuApp {
   std::chrono::steady_clock::time_point last_send_{};     // realtime, standby run: the last command send
   std::chrono::steady_clock::time_point last_block_at_{}; // ... and the last block from any corner
   bool cut_off_ = false;                                  // no block from any corner for kCutOff_s
+  // Lockstep with a standby: blocks of later periods than this CCU's, per corner (FIFO ring).
+  struct Stash {
+    struct Slot {
+      msg::MeasurementBlock block;
+      transport::EndpointId writer = 0;
+    };
+    std::array<Slot, 1024> slots;  // as deep as the measurement history (profile *_lockstep_standby)
+    std::size_t head = 0, count = 0;
+  };
+  std::vector<Stash> stash_;
+  std::uint64_t stash_overflows_ = 0;
   std::vector<std::pair<std::uint64_t, std::size_t>> restarts_;  // lockstep: (step, slot)
 };
 

@@ -57,7 +57,7 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       // bbw/dds/run_id.hpp), secure or not: the permissions grant a corner only its own
       // (docs/security.md). Its commands come in that partition too (the CCU writes each corner's there), calibration state in the run's partition run_<id>.
       blocks_(participant_, dds::kMeasurementTopic,
-              dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_writer, events,
+              dds::profiles_for(options.mode == ClockMode::Lockstep, options.standby).measurement_writer, events,
               dds::Partition{own_partition(options)}),
       health_(participant_, dds::kHealthTopic, "state_writer", events, dds::Partition{own_partition(options)}),
       // No DDS content filter on these topics: Fast DDS 2.9 evaluates DDS-SQL filters on the
@@ -149,7 +149,13 @@ void CornerApp::drain_inputs() {
       owners_.on_command(command_role(source.writer), command_in_.step(), command_in_.time_s(), runtime::mono_now_s());
     }
   }
-  while (calibration_.take(state_in_)) node_.on_calibration(state_in_);
+  transport::EndpointId cal_from = 0;
+  while (calibration_.take(state_in_, cal_from)) {
+    node_.on_calibration(state_in_);
+    if (options_.standby && calibration_writers_ < 2 && cal_from != calibration_writer_[0]) {
+      calibration_writer_[calibration_writers_++] = cal_from;
+    }
+  }
 }
 
 void CornerApp::simulate_period(std::uint64_t k) {
@@ -202,7 +208,10 @@ int CornerApp::run(std::string& error) {
       publish_health(msg::HEALTH_STARTING);
       republish = Clock::now() + std::chrono::milliseconds(200);
     }
-    return node_.have_command();
+    // Lockstep with a hot-standby CCU: both CCUs have begun (each sends its initial calibration
+    // states just before its first command), so neither starts far behind the corners.
+    const bool both_ccus = !options_.standby || options_.mode != ClockMode::Lockstep || calibration_writers_ >= 2;
+    return node_.have_command() && both_ccus;
   });
   if (!started) {
     if (events_.interrupted()) return kExitOk;

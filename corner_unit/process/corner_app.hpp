@@ -121,6 +121,8 @@ class CornerApp {
   std::array<std::uint8_t, 16> role_writer_{};
   runtime::CommandRole role_ = runtime::CommandRole::Unknown;
   bool have_role_ = false;
+  std::array<transport::EndpointId, 2> calibration_writer_{};  // the CCUs heard on CalibrationState
+  std::size_t calibration_writers_ = 0;
 };
 
 }  // namespace bbw::corner_process

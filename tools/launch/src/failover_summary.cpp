@@ -63,6 +63,7 @@ FailoverResult assess_failover(const FailoverInput& in) {
   for (std::size_t i = 0; i < in.corners.size(); ++i) {
     const FailoverCornerInput& c = in.corners[i];
     const auto& sw = c.owners.switches;
+    r.owners_at_end += (i == 0 ? "" : ",") + (sw.empty() ? std::string("none") : sw.back().to);
     r.max_command_gap_wall_ms = std::max(r.max_command_gap_wall_ms, c.owners.max_gap_mono_ms);
     r.max_command_gap_ms = std::max(r.max_command_gap_ms, in.lockstep ? c.owners.max_gap_sim_ms : c.owners.max_gap_mono_ms);
     if (c.ccu_lost_s >= 0.0) {
@@ -133,6 +134,7 @@ void write_failover(json::Writer& j, const FailoverResult& r) {
       .value("takeover_ms", took_over ? r.takeover_ms : nan)
       .value("takeover_wall_ms", took_over ? r.takeover_wall_ms : nan)
       .value("takeover_missing", r.takeover_missing)
+      .value("owners_at_end", r.owners_at_end)
       .value("corners_already_on_standby", r.corners_already_on_standby)
       .value("max_command_gap_ms", r.max_command_gap_ms)
       .value("max_command_gap_wall_ms", r.max_command_gap_wall_ms)

@@ -56,6 +56,7 @@ struct FailoverResult {
   double takeover_ms = -1.0;
   double takeover_wall_ms = -1.0;       // lockstep: the wall-clock wait; realtime: = takeover_ms
   std::string takeover_missing;         // corners that never took a standby command after it
+  std::string owners_at_end;            // each corner's last owner, in scenario order (comma-separated)
   int corners_already_on_standby = 0;   // the owner was the standby before the failure
   double max_command_gap_ms = 0.0;
   double max_command_gap_wall_ms = 0.0;

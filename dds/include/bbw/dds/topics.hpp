@@ -29,10 +29,15 @@ constexpr ProfileNames profiles_for(bool lockstep) {
           "command_reader_realtime"};
 }
 
-// With a hot-standby CCU (issue 16): the same, with the commands under EXCLUSIVE ownership,
-// KEEP_LAST 1 and a 10 ms deadline (config/dds/bbw_profiles.xml).
+// With a hot-standby CCU (issue 16): the same, with the commands under EXCLUSIVE ownership and a
+// 10 ms deadline, and in lockstep measurement histories of 1024 blocks (the CCU that does not own
+// the corners' commands may lag them; config/dds/bbw_profiles.xml).
 constexpr ProfileNames profiles_for(bool lockstep, bool standby) {
   ProfileNames p = profiles_for(lockstep);
+  if (standby && lockstep) {
+    p.measurement_writer = "measurement_writer_lockstep_standby";
+    p.measurement_reader = "measurement_reader_lockstep_standby";
+  }
   if (standby) {
     p.command_writer = lockstep ? "command_writer_lockstep_owned" : "command_writer_realtime_owned";
     p.command_reader = lockstep ? "command_reader_lockstep_owned" : "command_reader_realtime_owned";
