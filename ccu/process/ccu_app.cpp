@@ -78,7 +78,7 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
   const faults::Target self = options.standby && options.role == "standby" ? faults::Target::CcuStandby : faults::Target::CCU;
   if (options.standby) {
     failover_.role = options.role;
-    failover_.strength_initial = dds::ccu_strength(options.role != "standby", 0);
+    failover_.strength_initial = dds::ccu_strength(options.role != "standby", 0, 0);
     set_strength(failover_.strength_initial);
   }
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
@@ -156,10 +156,12 @@ void CcuApp::set_strength(std::uint32_t strength) {
   failover_.strength_final = strength;
 }
 
-void CcuApp::demote(double sim_s, const char* reason) {
+void CcuApp::demote(double sim_s, const char* reason, bool long_outage) {
   if (!options_.standby) return;
   ++failover_.outages;
-  set_strength(dds::ccu_strength(options_.role != "standby", failover_.outages));
+  if (long_outage) ++failover_.long_outages;
+  set_strength(dds::ccu_strength(options_.role != "standby", failover_.long_outages,
+                                 failover_.outages - failover_.long_outages));
   failover_.demoted_sim_s = sim_s;
   failover_.demoted_mono_s = runtime::mono_now_s();
   failover_.demote_reason = reason;
@@ -296,7 +298,7 @@ void CcuApp::freeze_for_hang(double at_s) {
   write_failover_stats();
   ::raise(SIGSTOP);
   failover_.resumed_mono_s = runtime::mono_now_s();
-  demote(at_s, "resumed after a stop");
+  demote(at_s, "resumed after a stop", true);
 }
 
 int CcuApp::run(std::string& error) {
@@ -396,9 +398,9 @@ int CcuApp::run(std::string& error) {
         const auto now = Clock::now();
         const double send_gap_s = std::chrono::duration<double>(now - last_send_).count();
         const double quiet_s = std::chrono::duration<double>(now - last_block_at_).count();
-        if (last_send_ != Clock::time_point{} && send_gap_s > kOwnershipDeadline_s) demote(t_k, "stalled");
+        if (last_send_ != Clock::time_point{} && send_gap_s > kOwnershipDeadline_s) demote(t_k, "stalled", false);
         if (last_block_at_ != Clock::time_point{} && quiet_s > kCutOff_s && k + 4 < periods_ && !cut_off_) {
-          demote(t_k, "cut off from every corner");
+          demote(t_k, "cut off from every corner", true);
           cut_off_ = true;  // one outage until a block arrives again
         }
         // The gap to the next send starts now: the demotion's own time (set_qos) is not a stall.

@@ -79,7 +79,7 @@ class CcuApp {
   // The scheduled hang: freezes (SIGSTOP) like a kill; returns when the launcher continues it.
   void freeze_for_hang(double at_s);
   // An outage: lowers this CCU's command strength (dds::ccu_strength; docs/faults.md "Hand-back").
-  void demote(double sim_s, const char* reason);
+  void demote(double sim_s, const char* reason, bool long_outage);
   void set_strength(std::uint32_t strength);
   void write_failover_stats() const;
   double realtime_now_s() const;

@@ -57,6 +57,8 @@ FailoverResult assess_failover(const FailoverInput& in) {
   r.demote_reason = in.primary.demote_reason;
   r.primary_outages = static_cast<int>(in.primary.outages);
   r.standby_outages = static_cast<int>(in.standby.outages);
+  r.primary_long_outages = static_cast<int>(in.primary.long_outages);
+  r.standby_long_outages = static_cast<int>(in.standby.long_outages);
   const ccu::CommandPlanner planner(*in.scenario);
   double takeover_mono = -std::numeric_limits<double>::infinity();
   double takeover_sim = -std::numeric_limits<double>::infinity();
@@ -151,6 +153,8 @@ void write_failover(json::Writer& j, const FailoverResult& r) {
       .value("primary_demote_reason", r.demote_reason)
       .value("primary_outages", r.primary_outages)
       .value("standby_outages", r.standby_outages)
+      .value("primary_long_outages", r.primary_long_outages)
+      .value("standby_long_outages", r.standby_long_outages)
       .value("standby_failed_s", r.standby_failed_s >= 0.0 ? r.standby_failed_s : nan)
       .end_object();
 }

@@ -71,7 +71,8 @@ struct FailoverResult {
   int switches_back_to_primary = 0;     // after the failure, to the primary (flapping)
   double demoted_s = -1.0;              // the primary last lowered its strength (hand-back policy)
   std::string demote_reason;            // ... and why
-  int primary_outages = 0, standby_outages = 0;
+  int primary_outages = 0, standby_outages = 0;            // all outages (stalls and long ones)
+  int primary_long_outages = 0, standby_long_outages = 0;
   double standby_failed_s = -1.0;       // the standby's own failure (both lost)
 };
 

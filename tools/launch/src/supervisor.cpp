@@ -129,7 +129,10 @@ Supervisor::Supervisor(RunPlan plan, const std::atomic<int>& stop_signal)
   // bbw_localhost_udp in config/dds/bbw_profiles.xml explains why).
   bool corner_restarts = false;
   for (const auto& a : actions_) corner_restarts |= a.kind == faults::ProcessAction::Kind::Restart;
-  if (corner_restarts) profile_args_ = {"--dds-participant-profile", "bbw_localhost_udp"};
+  // So does a run with a hot-standby CCU: a CCU stopped (hung) inside a shared-memory port
+  // operation holds that port's lock, and its peers' sends through it wait until it is continued
+  // (seen: two corners got no command for the whole 0.5 s hang; docs/faults.md).
+  if (corner_restarts || plan_.standby) profile_args_ = {"--dds-participant-profile", "bbw_localhost_udp"};
   bin_ = runtime::executable_dir();
   // Test hook: BBW_LAUNCH_CORNER_BIN replaces the corner executable (e.g. one that fails to
   // start), so the failure path is exercised with real processes.

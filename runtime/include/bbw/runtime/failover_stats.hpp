@@ -26,6 +26,7 @@ struct CcuFailoverStats {
   double failed_mono_s = -1.0;
   double resumed_mono_s = -1.0;      // continued after the hang (-1: never)
   std::uint32_t outages = 0;         // times it lowered its strength (an outage: docs/faults.md "Hand-back")
+  std::uint32_t long_outages = 0;    // ... of which long (stopped and continued, cut off from every corner)
   double demoted_sim_s = -1.0;       // the last time it did (-1: never)
   double demoted_mono_s = -1.0;
   std::string demote_reason;         // the last reason: "" | resumed after a stop | cut off from every corner | stalled
