@@ -29,11 +29,16 @@ dds::ParticipantOptions named(dds::ParticipantOptions p, const CcuOptions& o) {
 // standby's grant reaches a corner soon after the corner dropped a silent primary.
 constexpr auto kStandbyResend = std::chrono::milliseconds(10);
 // A CCU whose own commands were this far apart may have lost the corners' ownership to the other
-// CCU: the command deadline of the *_owned profiles.
+// CCU for a moment (a stall): the command deadline of the *_owned profiles.
 constexpr double kOwnershipDeadline_s = 0.010;
 // A CCU that heard no block from any corner this long is cut off (its link is down): longer than
 // the measurement deadline (15 ms), so one late period of every corner is not a cut.
 constexpr double kCutOff_s = 0.050;
+// After a long outage (continued after a stop, or its link back after a cut) a CCU sends no
+// command for this long: its state is stale, and its lowered strength must reach every corner
+// first. Fast DDS sends the strength by discovery, which a cut link delays: the corners took the
+// primary back for 550 ms after its link returned before they had its lowered strength.
+constexpr auto kRejoinQuiet = std::chrono::milliseconds(1000);
 
 
 // The first period that starts at or after time_s.
@@ -78,7 +83,7 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
   const faults::Target self = options.standby && options.role == "standby" ? faults::Target::CcuStandby : faults::Target::CCU;
   if (options.standby) {
     failover_.role = options.role;
-    failover_.strength_initial = dds::ccu_strength(options.role != "standby", 0, 0);
+    failover_.strength_initial = dds::ccu_strength(options.role != "standby", 0);
     set_strength(failover_.strength_initial);
   }
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
@@ -141,6 +146,10 @@ bool CcuApp::wait_for_corners(std::string& error) {
 void CcuApp::send_commands(std::uint64_t step, bool stop, bool log) {
   // The node's commands are in channel order, as commands_.
   const auto& cmds = node_.commands(step, stop, log);
+  // Cut off, or back from an outage: nothing. A command written while cut off would reach the
+  // corners when the link returns, before the lowered strength does, and they would take it
+  // (seen: FL applied such a command, computed with every corner lost, 0 kN, for 25 ms).
+  if (options_.standby && !stop && (cut_off_ || Clock::now() < quiet_until_)) return;
   for (std::size_t i = 0; i < cmds.size(); ++i) commands_[i]->send(cmds[i]);
 }
 
@@ -156,12 +165,10 @@ void CcuApp::set_strength(std::uint32_t strength) {
   failover_.strength_final = strength;
 }
 
-void CcuApp::demote(double sim_s, const char* reason, bool long_outage) {
+void CcuApp::demote(double sim_s, const char* reason) {
   if (!options_.standby) return;
   ++failover_.outages;
-  if (long_outage) ++failover_.long_outages;
-  set_strength(dds::ccu_strength(options_.role != "standby", failover_.long_outages,
-                                 failover_.outages - failover_.long_outages));
+  set_strength(dds::ccu_strength(options_.role != "standby", failover_.outages));
   failover_.demoted_sim_s = sim_s;
   failover_.demoted_mono_s = runtime::mono_now_s();
   failover_.demote_reason = reason;
@@ -191,6 +198,7 @@ void CcuApp::drain_blocks(double arrival_s, std::optional<std::uint64_t> step) {
   for (std::size_t i = 0; i < node_.channels(); ++i) {
     while (blocks_[i]->take(block_, writer)) {
       last_block_at_ = Clock::now();
+      if (cut_off_) quiet_until_ = last_block_at_ + kRejoinQuiet;  // the link is back
       cut_off_ = false;
       if (block_.corner_id() == node_.channel(i).slot) instances_[i] = blocks_[i]->last_info().instance_handle;
       node_.on_block(i, block_, writer, realtime ? realtime_now_s() : arrival_s);
@@ -209,6 +217,7 @@ void CcuApp::drain_blocks_in_order(double arrival_s, std::uint64_t step) {
     Stash& s = stash_[i];
     auto process = [&](const msg::MeasurementBlock& b, transport::EndpointId writer) {
       last_block_at_ = Clock::now();
+      if (cut_off_) quiet_until_ = last_block_at_ + kRejoinQuiet;  // the link is back
       cut_off_ = false;
       node_.on_block(i, b, writer, arrival_s);
       send_calibration_updates();
@@ -298,7 +307,8 @@ void CcuApp::freeze_for_hang(double at_s) {
   write_failover_stats();
   ::raise(SIGSTOP);
   failover_.resumed_mono_s = runtime::mono_now_s();
-  demote(at_s, "resumed after a stop", true);
+  demote(at_s, "resumed after a stop");
+  quiet_until_ = Clock::now() + kRejoinQuiet;
 }
 
 int CcuApp::run(std::string& error) {
@@ -307,6 +317,7 @@ int CcuApp::run(std::string& error) {
   for (const msg::CalibrationState& s : node_.initial_states()) calibration_.send(s);
   const double T = scenario_.ccu_period_s;
   t0_ = Clock::now();
+  failover_.t0_mono_s = std::chrono::duration<double>(t0_.time_since_epoch()).count();
   int rc = kExitOk;
   bool retired = false;
   std::uint32_t expected_incarnation[kSlots] = {};
@@ -346,6 +357,15 @@ int CcuApp::run(std::string& error) {
       for (;;) {
         ok = events_.wait_until(std::min(give_up, Clock::now() + resend), pred);
         if (ok || events_.interrupted() || Clock::now() >= give_up) break;
+        // A standby run: no block from any corner for kCutOff_s of wall time while waiting is a
+        // cut link (the corners go on under the other CCU). Who leads never changes a lockstep
+        // log (both CCUs compute the same commands), so a slow machine mistaken for a cut costs
+        // nothing but the order of the two CCUs.
+        if (options_.standby && !cut_off_ && last_block_at_ != Clock::time_point{} &&
+            std::chrono::duration<double>(Clock::now() - last_block_at_).count() > kCutOff_s) {
+          demote(t_k, "cut off from every corner");
+          cut_off_ = true;
+        }
         send_commands(k, false, false);
       }
       if (const std::string failed = node_.end_lockstep_period(k, t_end); !failed.empty()) {
@@ -398,9 +418,11 @@ int CcuApp::run(std::string& error) {
         const auto now = Clock::now();
         const double send_gap_s = std::chrono::duration<double>(now - last_send_).count();
         const double quiet_s = std::chrono::duration<double>(now - last_block_at_).count();
-        if (last_send_ != Clock::time_point{} && send_gap_s > kOwnershipDeadline_s) demote(t_k, "stalled", false);
+        // A stall beyond the corners' command deadline is counted, not acted on: the corners go
+        // to the other CCU for the stall and come back (the commands are the same; docs/faults.md).
+        if (last_send_ != Clock::time_point{} && send_gap_s > kOwnershipDeadline_s) ++failover_.stalls;
         if (last_block_at_ != Clock::time_point{} && quiet_s > kCutOff_s && k + 4 < periods_ && !cut_off_) {
-          demote(t_k, "cut off from every corner", true);
+          demote(t_k, "cut off from every corner");
           cut_off_ = true;  // one outage until a block arrives again
         }
         // The gap to the next send starts now: the demotion's own time (set_qos) is not a stall.

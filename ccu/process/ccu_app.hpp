@@ -78,8 +78,9 @@ class CcuApp {
   [[noreturn]] void freeze_for_kill(double at_s);
   // The scheduled hang: freezes (SIGSTOP) like a kill; returns when the launcher continues it.
   void freeze_for_hang(double at_s);
-  // An outage: lowers this CCU's command strength (dds::ccu_strength; docs/faults.md "Hand-back").
-  void demote(double sim_s, const char* reason, bool long_outage);
+  // An outage (stopped and continued, cut off): lowers this CCU's command strength
+  // (dds::ccu_strength; docs/faults.md "Hand-back").
+  void demote(double sim_s, const char* reason);
   void set_strength(std::uint32_t strength);
   void write_failover_stats() const;
   double realtime_now_s() const;
@@ -115,6 +116,7 @@ class CcuApp {
   std::chrono::steady_clock::time_point last_send_{};     // realtime, standby run: the last command send
   std::chrono::steady_clock::time_point last_block_at_{}; // ... and the last block from any corner
   bool cut_off_ = false;                                  // no block from any corner for kCutOff_s
+  std::chrono::steady_clock::time_point quiet_until_{};   // back from a long outage: no command until then
   // Lockstep with a standby: blocks of later periods than this CCU's, per corner (FIFO ring).
   struct Stash {
     struct Slot {

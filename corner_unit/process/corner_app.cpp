@@ -143,9 +143,9 @@ void CornerApp::drain_inputs() {
   while (commands_.take(command_in_, from)) {
     if (command_in_.corner_id() != dds::corner_index(options_.corner)) continue;  // another corner's
     const corner::CommandSource source = command_source();
-    const std::uint64_t accepted_before = node_.stats().commands_received;
+    const std::uint64_t taken_before = node_.stats().commands_taken;
     node_.on_command(command_in_, source, started_ ? sim_now_s() : 0.0);
-    if (options_.standby && node_.stats().commands_received != accepted_before) {
+    if (options_.standby && node_.stats().commands_taken != taken_before) {
       owners_.on_command(command_role(source.writer), command_in_.step(), command_in_.time_s(), runtime::mono_now_s());
     }
   }

@@ -22,6 +22,8 @@ std::uint64_t periods_of(const scenario::Scenario& s) {
 
 namespace {
 
+constexpr double kTakeoverSkew_s = 0.05;
+
 const scenario::Scenario& validated(const scenario::Scenario& s, const CornerNodeOptions& o) {
   if (o.scenario_index >= s.corners.size()) throw std::invalid_argument("corner index out of range");
   if (s.corners[o.scenario_index].name != corner_name(o.corner)) {
@@ -109,8 +111,12 @@ void CornerNode::on_command(const msg::ClampCommand& cmd, const corner::CommandS
   }
   last_command_seq_ = cmd.seq();
   if (cmd.step() < resume_step_ && !cmd.stop()) return;  // a restarted corner joins at its resume step
-  const bool takeover = new_writer && !options_.lockstep;
+  // A takeover's command may name an earlier period (the CCUs' clocks start apart, by a few ms);
+  // one more than kTakeoverSkew_s older than the newest command taken is stale (a returning CCU's
+  // last command, delivered again by reliability) and is not taken.
+  const bool takeover = new_writer && !options_.lockstep && cmd.time_s() >= latest_command_.time_s() - kTakeoverSkew_s;
   if (!have_command_ || cmd.step() >= latest_command_.step() || takeover) {
+    ++stats_.commands_taken;
     latest_command_ = cmd;
     latest_command_.clamp_force_kN(force_kN);
     have_command_ = true;

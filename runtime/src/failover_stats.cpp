@@ -27,11 +27,12 @@ void ccu_fields(S& s, F&& f) {
   f("failed_mono_s", s.failed_mono_s);
   f("resumed_mono_s", s.resumed_mono_s);
   f("outages", s.outages);
-  f("long_outages", s.long_outages);
+  f("stalls", s.stalls);
   f("demoted_sim_s", s.demoted_sim_s);
   f("demoted_mono_s", s.demoted_mono_s);
   f("demote_reason", s.demote_reason);
   f("periods_done", s.periods_done);
+  f("t0_mono_s", s.t0_mono_s);
 }
 
 template <class S, class F>

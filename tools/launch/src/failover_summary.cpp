@@ -5,7 +5,9 @@
 #include <limits>
 #include <stdexcept>
 
+#include "bbw/common/csv.hpp"
 #include "bbw/node/command_plan.hpp"
+#include "bbw/runtime/run_stats.hpp"
 
 namespace bbw::launch {
 
@@ -38,6 +40,26 @@ ErrorStats tracking_error(const ccu::CommandPlanner& planner, std::size_t corner
 
 }  // namespace
 
+FailoverInput load_failover_input(const scenario::Scenario& scenario, const std::string& out_dir, bool lockstep) {
+  FailoverInput in;
+  in.scenario = &scenario;
+  in.lockstep = lockstep;
+  in.primary = runtime::load_ccu_failover(out_dir + "/ccu_failover.stats");
+  in.standby = runtime::load_ccu_failover(out_dir + "/standby/ccu_failover.stats");
+  for (const auto& corner : scenario.corners) {
+    const std::string& c = corner.name;
+    FailoverCornerInput ci;
+    ci.owners = runtime::load_corner_failover(out_dir + "/corner_" + c + "_failover.stats");
+    ci.ccu_lost_s = runtime::load_corner_stats(out_dir + "/corner_" + c + ".stats").ccu_lost_s;
+    csv::ReadOptions o;
+    o.required = {"time_s", "force_true_kN"};
+    const auto t = csv::read(out_dir + "/corner_" + c + "_periods.csv", o);
+    for (std::size_t r = 0; r < t.rows(); ++r) ci.periods.emplace_back(t.column("time_s")[r], t.column("force_true_kN")[r]);
+    in.corners.push_back(std::move(ci));
+  }
+  return in;
+}
+
 FailoverResult assess_failover(const FailoverInput& in) {
   if (in.scenario == nullptr) throw std::invalid_argument("assess_failover: no scenario");
   FailoverResult r;
@@ -57,8 +79,8 @@ FailoverResult assess_failover(const FailoverInput& in) {
   r.demote_reason = in.primary.demote_reason;
   r.primary_outages = static_cast<int>(in.primary.outages);
   r.standby_outages = static_cast<int>(in.standby.outages);
-  r.primary_long_outages = static_cast<int>(in.primary.long_outages);
-  r.standby_long_outages = static_cast<int>(in.standby.long_outages);
+  r.primary_stalls = static_cast<int>(in.primary.stalls);
+  r.standby_stalls = static_cast<int>(in.standby.stalls);
   const ccu::CommandPlanner planner(*in.scenario);
   double takeover_mono = -std::numeric_limits<double>::infinity();
   double takeover_sim = -std::numeric_limits<double>::infinity();
@@ -153,8 +175,8 @@ void write_failover(json::Writer& j, const FailoverResult& r) {
       .value("primary_demote_reason", r.demote_reason)
       .value("primary_outages", r.primary_outages)
       .value("standby_outages", r.standby_outages)
-      .value("primary_long_outages", r.primary_long_outages)
-      .value("standby_long_outages", r.standby_long_outages)
+      .value("primary_stalls", r.primary_stalls)
+      .value("standby_stalls", r.standby_stalls)
       .value("standby_failed_s", r.standby_failed_s >= 0.0 ? r.standby_failed_s : nan)
       .end_object();
 }

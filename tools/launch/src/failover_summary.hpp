@@ -71,10 +71,15 @@ struct FailoverResult {
   int switches_back_to_primary = 0;     // after the failure, to the primary (flapping)
   double demoted_s = -1.0;              // the primary last lowered its strength (hand-back policy)
   std::string demote_reason;            // ... and why
-  int primary_outages = 0, standby_outages = 0;            // all outages (stalls and long ones)
-  int primary_long_outages = 0, standby_long_outages = 0;
+  int primary_outages = 0, standby_outages = 0;  // stopped and continued, or cut off (hand-back rule)
+  int primary_stalls = 0, standby_stalls = 0;    // commands further apart than the command deadline
   double standby_failed_s = -1.0;       // the standby's own failure (both lost)
 };
+
+// The input from a run's output folder: OUT/ccu_failover.stats, OUT/standby/ccu_failover.stats,
+// OUT/corner_<C>_failover.stats, OUT/corner_<C>.stats (the watchdog) and OUT/corner_<C>_periods.csv
+// of the scenario's corners (first incarnations). Throws std::runtime_error naming the file.
+FailoverInput load_failover_input(const scenario::Scenario& scenario, const std::string& out_dir, bool lockstep);
 
 FailoverResult assess_failover(const FailoverInput& in);
 // Writes key "failover" into the open object of `j`.

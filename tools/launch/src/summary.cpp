@@ -320,20 +320,7 @@ RunTotals write_run_summary(const CompletedRun& run) {
   }
   j.end_array();
   if (run.standby) {
-    FailoverInput in;
-    in.scenario = &scenario;
-    in.lockstep = run.mode == "lockstep";
-    in.primary = runtime::load_ccu_failover(out_dir + "/ccu_failover.stats");
-    in.standby = runtime::load_ccu_failover(out_dir + "/standby/ccu_failover.stats");
-    for (std::size_t i = 0; i < scenario.corners.size(); ++i) {
-      const std::string& c = scenario.corners[i].name;
-      FailoverCornerInput ci;
-      ci.owners = runtime::load_corner_failover(out_dir + "/corner_" + c + "_failover.stats");
-      ci.ccu_lost_s = ccu_lost_s[c];
-      ci.periods = period_logs[i];
-      in.corners.push_back(std::move(ci));
-    }
-    write_failover(j, assess_failover(in));
+    write_failover(j, assess_failover(load_failover_input(scenario, out_dir, run.mode == "lockstep")));
   }
   j.end_object();
   j.save(out_dir + "/summary.json");

@@ -46,18 +46,16 @@ constexpr ProfileNames profiles_for(bool lockstep, bool standby) {
 }
 
 // Ownership strength of a CCU's command writers (issue 16, docs/faults.md "Hand-back"): the CCU
-// with fewer long outages leads, then the one with fewer stalls, then the primary. A long outage:
-// stopped and continued, or cut off from every corner (its state is stale when it returns). A
-// stall: its own commands further apart than the corners' command deadline. Either may have
-// moved the corners to the other CCU; strength only falls, so a returning CCU never takes them
-// back from one that stayed, and an outage both CCUs share (a machine stall) changes nothing.
-inline constexpr std::uint32_t kStrengthPerLongOutage = 100000000;
-inline constexpr std::uint32_t kStrengthPerStall = 10;
+// with fewer outages leads, the primary at equal counts. An outage: the CCU was stopped and
+// continued, or cut off from every corner; either may have moved the corners to the other CCU,
+// and its state is stale when it returns. Strength only falls, so a returning CCU never takes
+// the corners back from one that stayed. (A stall beyond the command deadline is no outage: the
+// corners go to the other CCU for the stall and come back, with the same commands.)
 inline constexpr std::uint32_t kStrengthBase = 1000000000;
-constexpr std::uint32_t ccu_strength(bool primary, std::uint32_t long_outages, std::uint32_t stalls) {
-  const std::uint32_t l = long_outages < 9 ? long_outages : 9;
-  const std::uint32_t s = stalls < 9999999 ? stalls : 9999999;
-  return kStrengthBase - l * kStrengthPerLongOutage - s * kStrengthPerStall + (primary ? 1u : 0u);
+inline constexpr std::uint32_t kStrengthPerOutage = 1000;
+constexpr std::uint32_t ccu_strength(bool primary, std::uint32_t outages) {
+  const std::uint32_t n = outages < 999999 ? outages : 999999;
+  return kStrengthBase - n * kStrengthPerOutage + (primary ? 1u : 0u);
 }
 
 }  // namespace bbw::dds

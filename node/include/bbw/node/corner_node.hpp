@@ -54,6 +54,7 @@ struct CornerStats {
   std::uint64_t write_failures = 0;
   std::uint64_t commands_received = 0;
   std::uint64_t commands_applied = 0;
+  std::uint64_t commands_taken = 0;    // became the newest command (a hot-standby run's owner record)
   std::uint64_t command_seq_gaps = 0;
   std::uint64_t calibrations_applied = 0;
   std::uint64_t calibrations_rejected = 0;

@@ -25,12 +25,13 @@ struct CcuFailoverStats {
   double failed_sim_s = -1.0;        // the simulated time it froze at (-1: never)
   double failed_mono_s = -1.0;
   double resumed_mono_s = -1.0;      // continued after the hang (-1: never)
-  std::uint32_t outages = 0;         // times it lowered its strength (an outage: docs/faults.md "Hand-back")
-  std::uint32_t long_outages = 0;    // ... of which long (stopped and continued, cut off from every corner)
+  std::uint32_t outages = 0;         // times it lowered its strength (stopped and continued, or cut off)
+  std::uint32_t stalls = 0;          // realtime: its own commands further apart than the command deadline
   double demoted_sim_s = -1.0;       // the last time it did (-1: never)
   double demoted_mono_s = -1.0;
-  std::string demote_reason;         // the last reason: "" | resumed after a stop | cut off from every corner | stalled
+  std::string demote_reason;         // the last reason: "" | resumed after a stop | cut off from every corner
   std::uint64_t periods_done = 0;
+  double t0_mono_s = -1.0;           // realtime: when its simulated time was 0 (its clock's start)
 };
 
 // One change of the writer a corner obeys (what DDS exclusive ownership let through).
