@@ -96,7 +96,8 @@ int main(int argc, char** argv) {
   try {
     if (!secure_dir.empty()) {
       opt.participant.properties = bbw::security::participant_properties(
-          bbw::security::files_for(secure_dir, bbw::security::kCcuIdentity));
+          bbw::security::files_for(secure_dir, opt.standby && opt.role == "standby" ? bbw::security::kCcuStandbyIdentity
+                                                                                  : bbw::security::kCcuIdentity));
     }
     auto fs = bbw::faults::load_fault_scenario(scenario_file);
     scenario = std::move(fs.scenario);

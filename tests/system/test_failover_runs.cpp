@@ -77,7 +77,8 @@ struct StandbyRun {
   }
 };
 
-StandbyRun launch_standby(const std::string& scenario, const std::string& test, int domain, const std::string& mode) {
+StandbyRun launch_standby(const std::string& scenario, const std::string& test, int domain, const std::string& mode,
+                          const std::vector<std::string>& extra = {}) {
   const std::string dir = scratch("failover", test);
   std::vector<std::string> argv;
   if (mode == "realtime" && ::geteuid() == 0 && ::access("/usr/bin/chrt", X_OK) == 0) argv = {"/usr/bin/chrt", "-f", "10"};
@@ -86,6 +87,7 @@ StandbyRun launch_standby(const std::string& scenario, const std::string& test, 
                                std::string("--discovery-timeout"), std::string("20"), std::string("--no-report")}) {
     argv.push_back(a);
   }
+  argv.insert(argv.end(), extra.begin(), extra.end());
   StandbyRun r;
   r.launch = run("bbw_launch", argv, dir, 120s);
   r.out = dir + "/out";
@@ -221,6 +223,26 @@ TEST(SystemFailover, BothCcusLostRealtimeGivesTheSafeState) {  // domain 65
     const double lost = std::stod(c.at("ccu_lost_detected_s"));
     EXPECT_GE(lost, 4.0) << c.at("corner") << ": safe state before the standby was lost\n" << r.report();
     EXPECT_LE(lost, 4.06) << c.at("corner") << "\n" << r.report();
+  }
+}
+
+// With --secure the standby is its own DDS Security identity (bbw_ccu_standby) with the CCU's
+// rights: its commands pass the corners' access control (it takes over), and only the two CCU
+// identities may publish commands at all.
+TEST(SystemFailover, SecureStandbyHasItsOwnIdentity) {  // domain 69
+  const std::string keys = scratch("failover", "keys");
+  const StandbyRun r = launch_standby("ccu_failover_kill.yaml", "secure", 69, "lockstep", {"--secure", "--keys", keys});
+  ASSERT_TRUE(r.launch.status.ok()) << r.report();
+  expect_clean_takeover(r, "kill", true);
+  EXPECT_EQ(r.failover.at("owners_at_end"), "standby,standby,standby,standby") << r.report();
+  const std::string standby = slurp(keys + "/ccu_standby/permissions.xml");
+  EXPECT_NE(standby.find("CN=bbw_ccu_standby"), std::string::npos) << standby;
+  for (const std::string id : {"ccu", "ccu_standby", "fl", "fr", "rl", "rr"}) {
+    const std::string perm = slurp(keys + "/" + id + "/permissions.xml");
+    const auto publish = perm.find("<publish>");
+    ASSERT_NE(publish, std::string::npos) << id;
+    const bool commands = perm.substr(publish, perm.find("</publish>") - publish).find("bbw/ClampCommand") != std::string::npos;
+    EXPECT_EQ(commands, id == "ccu" || id == "ccu_standby") << id << " may publish commands: " << commands;
   }
 }
 
