@@ -168,12 +168,22 @@ void CcuApp::set_strength(std::uint32_t strength) {
 void CcuApp::demote(double sim_s, const char* reason) {
   if (!options_.standby) return;
   ++failover_.outages;
-  set_strength(dds::ccu_strength(options_.role != "standby", failover_.outages));
+  set_strength(dds::ccu_strength(options_.role != "standby", failover_.outages) - std::min<std::uint32_t>(reannouncements_, 999));
   failover_.demoted_sim_s = sim_s;
   failover_.demoted_mono_s = runtime::mono_now_s();
   failover_.demote_reason = reason;
   std::cout << "bbw_ccu (" << options_.role << "): lowered its command strength to " << failover_.strength_final
             << " at " << sim_s << " s (" << reason << ")" << std::endl;
+}
+
+// The link is back after a cut: quiet for kRejoinQuiet, and the lowered strength announced again
+// (set while cut off, its discovery message may not have reached the corners: once they kept the
+// returned primary as the owner for the rest of the run). A strength 1 lower is a new value, so
+// Fast DDS announces it now; the order of the two CCUs (steps of 1000) does not change.
+void CcuApp::link_back() {
+  quiet_until_ = Clock::now() + kRejoinQuiet;
+  ++reannouncements_;
+  set_strength(dds::ccu_strength(options_.role != "standby", failover_.outages) - std::min<std::uint32_t>(reannouncements_, 999));
 }
 
 void CcuApp::write_failover_stats() const {
@@ -198,7 +208,7 @@ void CcuApp::drain_blocks(double arrival_s, std::optional<std::uint64_t> step) {
   for (std::size_t i = 0; i < node_.channels(); ++i) {
     while (blocks_[i]->take(block_, writer)) {
       last_block_at_ = Clock::now();
-      if (cut_off_) quiet_until_ = last_block_at_ + kRejoinQuiet;  // the link is back
+      if (cut_off_) link_back();
       cut_off_ = false;
       if (block_.corner_id() == node_.channel(i).slot) instances_[i] = blocks_[i]->last_info().instance_handle;
       node_.on_block(i, block_, writer, realtime ? realtime_now_s() : arrival_s);
@@ -217,7 +227,7 @@ void CcuApp::drain_blocks_in_order(double arrival_s, std::uint64_t step) {
     Stash& s = stash_[i];
     auto process = [&](const msg::MeasurementBlock& b, transport::EndpointId writer) {
       last_block_at_ = Clock::now();
-      if (cut_off_) quiet_until_ = last_block_at_ + kRejoinQuiet;  // the link is back
+      if (cut_off_) link_back();
       cut_off_ = false;
       node_.on_block(i, b, writer, arrival_s);
       send_calibration_updates();

@@ -82,6 +82,7 @@ class CcuApp {
   // (dds::ccu_strength; docs/faults.md "Hand-back").
   void demote(double sim_s, const char* reason);
   void set_strength(std::uint32_t strength);
+  void link_back();
   void write_failover_stats() const;
   double realtime_now_s() const;
 
@@ -117,6 +118,7 @@ class CcuApp {
   std::chrono::steady_clock::time_point last_block_at_{}; // ... and the last block from any corner
   bool cut_off_ = false;                                  // no block from any corner for kCutOff_s
   std::chrono::steady_clock::time_point quiet_until_{};   // back from a long outage: no command until then
+  std::uint32_t reannouncements_ = 0;                     // strength announced again after a cut
   // Lockstep with a standby: blocks of later periods than this CCU's, per corner (FIFO ring).
   struct Stash {
     struct Slot {
