@@ -153,6 +153,12 @@ void CcuApp::send_commands(std::uint64_t step, bool stop, bool log) {
   for (std::size_t i = 0; i < cmds.size(); ++i) commands_[i]->send(cmds[i]);
 }
 
+// dds::ccu_strength, 1 lower per re-announcement after a cut (at most 999: the order of the two
+// CCUs, steps of 1000, never changes by it).
+std::uint32_t CcuApp::strength() const {
+  return dds::ccu_strength(options_.role != "standby", failover_.outages) - std::min<std::uint32_t>(reannouncements_, 999);
+}
+
 void CcuApp::set_strength(std::uint32_t strength) {
   for (auto& c : commands_) {
     auto& w = c->get().get();
@@ -168,7 +174,7 @@ void CcuApp::set_strength(std::uint32_t strength) {
 void CcuApp::demote(double sim_s, const char* reason) {
   if (!options_.standby) return;
   ++failover_.outages;
-  set_strength(dds::ccu_strength(options_.role != "standby", failover_.outages) - std::min<std::uint32_t>(reannouncements_, 999));
+  set_strength(strength());
   failover_.demoted_sim_s = sim_s;
   failover_.demoted_mono_s = runtime::mono_now_s();
   failover_.demote_reason = reason;
@@ -183,7 +189,7 @@ void CcuApp::demote(double sim_s, const char* reason) {
 void CcuApp::link_back() {
   quiet_until_ = Clock::now() + kRejoinQuiet;
   ++reannouncements_;
-  set_strength(dds::ccu_strength(options_.role != "standby", failover_.outages) - std::min<std::uint32_t>(reannouncements_, 999));
+  set_strength(strength());
 }
 
 void CcuApp::write_failover_stats() const {
@@ -423,8 +429,8 @@ int CcuApp::run(std::string& error) {
       }
       if (options_.standby) {
         // Out of the loop long enough for the corners to drop this CCU as their owner: stalled
-        // (its own commands too far apart), or cut off (no block from any corner). It then lets
-        // the other CCU keep the corners (docs/faults.md, "Hand-back").
+        // (its own commands too far apart: counted), or cut off (no block from any corner: an
+        // outage, docs/faults.md "Who commands").
         const auto now = Clock::now();
         const double send_gap_s = std::chrono::duration<double>(now - last_send_).count();
         const double quiet_s = std::chrono::duration<double>(now - last_block_at_).count();

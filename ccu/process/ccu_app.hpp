@@ -81,6 +81,7 @@ class CcuApp {
   // An outage (stopped and continued, cut off): lowers this CCU's command strength
   // (dds::ccu_strength; docs/faults.md "Hand-back").
   void demote(double sim_s, const char* reason);
+  std::uint32_t strength() const;
   void set_strength(std::uint32_t strength);
   void link_back();
   void write_failover_stats() const;

@@ -15,6 +15,7 @@
 #include "bbw/runtime/command_owner.hpp"
 #include "bbw/runtime/failover_stats.hpp"
 #include "failover_summary.hpp"
+#include "options.hpp"
 #include "out_dir.hpp"
 
 namespace {
@@ -170,6 +171,49 @@ TEST(LaunchOutDir, AStandbyRunsFilesAreOwnAndCleared) {
   EXPECT_THROW(launch::prepare_out_dir(d.string()), std::invalid_argument);
   EXPECT_TRUE(fs::exists(d / "standby" / "notes.txt"));
   fs::remove_all(d);
+}
+
+}  // namespace
+
+namespace {
+
+// bbw_launch's checks of a standby scenario before anything starts.
+TEST(LaunchStandbyChecks, LinkCutIsRefusedAndAHangNeedsAStandby) {
+  const std::string dir = std::string(BBW_TEST_SOURCE_DIR) + "/config/scenarios/faults/";
+  bbw::launch::Options o;
+  o.scenario_file = dir + "ccu_failover_link_cut.yaml";
+  try {
+    bbw::launch::load_run(o);
+    FAIL() << "a link cut must be refused";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("line 32: a link_cut needs the processes in network namespaces"), std::string::npos)
+        << e.what();
+  }
+  o.scenario_file = dir + "ccu_failover_hang.yaml";
+  EXPECT_TRUE(bbw::launch::load_run(o).schedule.standby);
+  // The same hang without `standby: true` (the scenario's key removed) and without --standby.
+  const auto p = std::filesystem::temp_directory_path() / ("bbw_hang_no_standby_" + std::to_string(::getpid()) + ".yaml");
+  {
+    std::ifstream in(o.scenario_file);
+    std::ofstream out(p);
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line == "standby: true") continue;
+      if (line.rfind("plant: ", 0) == 0) line = "plant: " + std::string(BBW_TEST_SOURCE_DIR) + "/config/plant/ecaliper.yaml";
+      out << line << "\n";
+    }
+  }
+  o.scenario_file = p.string();
+  try {
+    bbw::launch::load_run(o);
+    FAIL() << "a hang without a standby must be refused";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("a CCU hang needs a hot-standby CCU (standby: true or --standby)"), std::string::npos)
+        << e.what();
+  }
+  o.standby = true;
+  EXPECT_TRUE(bbw::launch::load_run(o).schedule.standby);
+  std::filesystem::remove(p);
 }
 
 }  // namespace
