@@ -21,6 +21,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Older than this, a command is stale in a hot-standby run (ten CCU periods).
+constexpr auto kStaleCommand = std::chrono::milliseconds(50);
+
 node::CornerNodeOptions node_options(const CornerOptions& o) {
   node::CornerNodeOptions n;
   n.corner = o.corner;
@@ -117,6 +120,16 @@ corner::CommandSource CornerApp::command_source() const {
   return source;
 }
 
+// A hot-standby run, realtime: a command written more than kStaleCommand ago (by its source
+// timestamp: the same system clock on this host and in its network namespaces) is not taken.
+// After a cut, the returning CCU's last command arrives when the link comes back, and DDS may let
+// it through before the CCU's lowered strength has arrived (docs/faults.md, "Who commands").
+bool CornerApp::stale(const eprosima::fastdds::dds::SampleInfo& info) const {
+  const auto written = std::chrono::system_clock::time_point(std::chrono::duration_cast<std::chrono::system_clock::duration>(
+      std::chrono::nanoseconds(info.source_timestamp.to_ns())));
+  return std::chrono::system_clock::now() - written > kStaleCommand;
+}
+
 // The role of a command's writer, from its participant's announced name (cached per writer).
 runtime::CommandRole CornerApp::command_role(const std::array<std::uint8_t, 16>& writer) {
   if (have_role_ && writer == role_writer_) return role_;
@@ -142,6 +155,10 @@ void CornerApp::drain_inputs() {
   transport::EndpointId from = 0;
   while (commands_.take(command_in_, from)) {
     if (command_in_.corner_id() != dds::corner_index(options_.corner)) continue;  // another corner's
+    if (options_.standby && options_.mode == ClockMode::Realtime && stale(commands_.last_info())) {
+      ++stale_commands_;  // written too long ago: a returning CCU's last command, redelivered
+      continue;
+    }
     const corner::CommandSource source = command_source();
     const std::uint64_t taken_before = node_.stats().commands_taken;
     node_.on_command(command_in_, source, started_ ? sim_now_s() : 0.0);
@@ -183,6 +200,7 @@ void CornerApp::write_failover_stats() const {
   if (file.size() > ext.size() && file.compare(file.size() - ext.size(), ext.size(), ext) == 0) file.resize(file.size() - ext.size());
   runtime::CornerFailoverStats s = owners_.stats();
   s.corner = dds::corner_name(options_.corner);
+  s.commands_stale = stale_commands_;
   runtime::save(s, file + "_failover.stats");
 }
 

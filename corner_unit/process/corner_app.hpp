@@ -94,6 +94,7 @@ class CornerApp {
   bool ccu_gone() const;     // the CCU's command writer lost its liveliness
   corner::CommandSource command_source() const;
   runtime::CommandRole command_role(const std::array<std::uint8_t, 16>& writer);
+  bool stale(const eprosima::fastdds::dds::SampleInfo& info) const;
   void write_failover_stats() const;
   [[noreturn]] void freeze_for_kill();
   void finish_stats(std::chrono::steady_clock::time_point wall0);
@@ -123,6 +124,7 @@ class CornerApp {
   bool have_role_ = false;
   std::array<transport::EndpointId, 2> calibration_writer_{};  // the CCUs heard on CalibrationState
   std::size_t calibration_writers_ = 0;
+  std::uint64_t stale_commands_ = 0;  // realtime standby run: commands dropped as written too long ago
 };
 
 }  // namespace bbw::corner_process

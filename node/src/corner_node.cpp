@@ -22,8 +22,6 @@ std::uint64_t periods_of(const scenario::Scenario& s) {
 
 namespace {
 
-constexpr double kTakeoverSkew_s = 0.05;
-
 const scenario::Scenario& validated(const scenario::Scenario& s, const CornerNodeOptions& o) {
   if (o.scenario_index >= s.corners.size()) throw std::invalid_argument("corner index out of range");
   if (s.corners[o.scenario_index].name != corner_name(o.corner)) {
@@ -111,10 +109,11 @@ void CornerNode::on_command(const msg::ClampCommand& cmd, const corner::CommandS
   }
   last_command_seq_ = cmd.seq();
   if (cmd.step() < resume_step_ && !cmd.stop()) return;  // a restarted corner joins at its resume step
-  // A takeover's command may name an earlier period (the CCUs' clocks start apart, by a few ms);
-  // one more than kTakeoverSkew_s older than the newest command taken is stale (a returning CCU's
-  // last command, delivered again by reliability) and is not taken.
-  const bool takeover = new_writer && !options_.lockstep && cmd.time_s() >= latest_command_.time_s() - kTakeoverSkew_s;
+  // Realtime: a takeover's command may name an earlier period (the two CCUs' clocks start apart);
+  // it is taken all the same (DDS ownership chose its writer). A stale one (a returning CCU's
+  // last command, delivered again by reliability) never gets here: the adapter drops commands
+  // written too long ago (CornerApp::drain_inputs).
+  const bool takeover = new_writer && !options_.lockstep;
   if (!have_command_ || cmd.step() >= latest_command_.step() || takeover) {
     ++stats_.commands_taken;
     latest_command_ = cmd;

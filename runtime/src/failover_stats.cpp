@@ -41,6 +41,7 @@ void corner_fields(S& s, F&& f) {
   f("commands_primary", s.commands_primary);
   f("commands_standby", s.commands_standby);
   f("commands_unknown", s.commands_unknown);
+  f("commands_stale", s.commands_stale);
   f("max_gap_mono_ms", s.max_gap_mono_ms);
   f("max_gap_mono_at_sim_s", s.max_gap_mono_at_sim_s);
   f("max_gap_sim_ms", s.max_gap_sim_ms);

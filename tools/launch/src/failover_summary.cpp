@@ -87,6 +87,7 @@ FailoverResult assess_failover(const FailoverInput& in) {
   for (std::size_t i = 0; i < in.corners.size(); ++i) {
     const FailoverCornerInput& c = in.corners[i];
     const auto& sw = c.owners.switches;
+    r.commands_stale += static_cast<long long>(c.owners.commands_stale);
     r.owners_at_end += (i == 0 ? "" : ",") + (sw.empty() ? std::string("none") : sw.back().to);
     r.max_command_gap_wall_ms = std::max(r.max_command_gap_wall_ms, c.owners.max_gap_mono_ms);
     r.max_command_gap_ms = std::max(r.max_command_gap_ms, in.lockstep ? c.owners.max_gap_sim_ms : c.owners.max_gap_mono_ms);
@@ -171,6 +172,7 @@ void write_failover(json::Writer& j, const FailoverResult& r) {
       .value("switches_before_failure", r.switches_before_failure)
       .value("switches_after_failure", r.switches_after_failure)
       .value("switches_back_to_primary", r.switches_back_to_primary)
+      .value("commands_stale", r.commands_stale)
       .value("primary_demoted_s", r.demoted_s >= 0.0 ? r.demoted_s : nan)
       .value("primary_demote_reason", r.demote_reason)
       .value("primary_outages", r.primary_outages)

@@ -69,6 +69,7 @@ struct FailoverResult {
   int switches_before_failure = 0;      // owner changes before the failure (not the start's settling)
   int switches_after_failure = 0;       // ... at or after it (1 per corner: a clean takeover)
   int switches_back_to_primary = 0;     // after the failure, to the primary (flapping)
+  long long commands_stale = 0;         // realtime: commands the corners dropped as too old
   double demoted_s = -1.0;              // the primary last lowered its strength (hand-back policy)
   std::string demote_reason;            // ... and why
   int primary_outages = 0, standby_outages = 0;  // stopped and continued, or cut off (hand-back rule)

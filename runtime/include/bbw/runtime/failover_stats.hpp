@@ -48,6 +48,7 @@ struct CornerFailoverStats {
   std::uint64_t commands_primary = 0;
   std::uint64_t commands_standby = 0;
   std::uint64_t commands_unknown = 0;
+  std::uint64_t commands_stale = 0;     // realtime: dropped, written more than 50 ms before they arrived
   // Longest time between two consecutive commands taken, after the first: on the monotonic
   // clock (what a realtime corner lives by) and in simulated periods (lockstep's time).
   double max_gap_mono_ms = 0.0;
