@@ -5,7 +5,15 @@
 // namespaces as unicast initial peers. Needs root; callers skip without it.
 #pragma once
 
+#include <fcntl.h>
+#include <net/if.h>
+#include <sched.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
 #include <unistd.h>
+
+#include <cstring>
+#include <thread>
 
 #include <chrono>
 #include <filesystem>
@@ -122,6 +130,40 @@ inline std::string netns_profiles(const std::string& address, const std::vector<
   if (pe == std::string::npos) return {};
   xml.insert(pe, participant);
   return xml;
+}
+
+// Sets `dev` in namespace `ns` up or down from this process, in a thread that enters the
+// namespace (setns affects the calling thread only): no fork and exec, so the instant of the
+// change is known to microseconds. `before_s`/`after_s`: CLOCK_MONOTONIC seconds around the
+// ioctl. Returns "" or what failed.
+inline std::string set_link(const std::string& ns, const std::string& dev, bool up, double& before_s, double& after_s) {
+  std::string error;
+  std::thread t([&] {
+    const int nsfd = ::open(("/run/netns/" + ns).c_str(), O_RDONLY | O_CLOEXEC);
+    if (nsfd < 0 || ::setns(nsfd, CLONE_NEWNET) != 0) {
+      error = "cannot enter /run/netns/" + ns + ": " + std::strerror(errno);
+      if (nsfd >= 0) ::close(nsfd);
+      return;
+    }
+    ::close(nsfd);
+    const int s = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    ifreq ifr{};
+    std::strncpy(ifr.ifr_name, dev.c_str(), IFNAMSIZ - 1);
+    if (s < 0 || ::ioctl(s, SIOCGIFFLAGS, &ifr) != 0) {
+      error = "cannot read the flags of " + dev + " in " + ns + ": " + std::strerror(errno);
+    } else {
+      if (up) ifr.ifr_flags = static_cast<short>(ifr.ifr_flags | IFF_UP);
+      else ifr.ifr_flags = static_cast<short>(ifr.ifr_flags & ~IFF_UP);
+      auto now = [] { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); };
+      before_s = now();
+      const int rc = ::ioctl(s, SIOCSIFFLAGS, &ifr);
+      after_s = now();
+      if (rc != 0) error = "cannot set " + dev + (up ? " up" : " down") + " in " + ns + ": " + std::strerror(errno);
+    }
+    if (s >= 0) ::close(s);
+  });
+  t.join();
+  return error;
 }
 
 }  // namespace bbw::netns_test

@@ -57,6 +57,21 @@ std::map<std::string, std::string> object(const std::string& json, const std::st
   return m;
 }
 
+// The .err file under out_dir of a process that died of one of Fast DDS 2.9's own assertions
+// named above, or "".
+std::string fastdds_abort(const std::string& out_dir) {
+  if (const std::string f = fastdds_pdp_abort(out_dir); !f.empty()) return f;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(out_dir, ec)) {
+    if (e.path().extension() != ".err") continue;
+    const std::string text = slurp(e.path().string());
+    if (text.find("RTPSStatisticsMessages.hpp") != std::string::npos && text.find("Assertion") != std::string::npos) {
+      return e.path().string();
+    }
+  }
+  return "";
+}
+
 double num(const std::map<std::string, std::string>& m, const std::string& k) {
   const auto it = m.find(k);
   if (it == m.end() || it->second == "null") {
@@ -89,7 +104,17 @@ StandbyRun launch_standby(const std::string& scenario, const std::string& test, 
   }
   argv.insert(argv.end(), extra.begin(), extra.end());
   StandbyRun r;
-  r.launch = run("bbw_launch", argv, dir, 120s);
+  for (int attempt = 1;; ++attempt) {
+    r.launch = run("bbw_launch", argv, dir, 120s);
+    // Fast DDS 2.9 aborts now and then inside its own code (assertions left on in Debian's
+    // build): the discovery race of docs/faults.md, and, with --secure, a statistics submessage
+    // that does not fit the message buffer (RTPSStatisticsMessages.hpp:100, 1 of 3 secure runs
+    // once). On these, and only on these, the run is repeated (at most twice), with a note.
+    const std::string abort_file = r.launch.status.ok() ? "" : fastdds_abort(dir + "/out");
+    if (abort_file.empty() || attempt == 3) break;
+    std::cout << "[ NOTE     ] run " << attempt << " of " << scenario << " hit a Fast DDS 2.9 assertion, in " << abort_file
+              << "; running it again" << std::endl;
+  }
   r.out = dir + "/out";
   r.failover = object(slurp(r.out + "/summary.json"), "failover");
   // The measured figures, for docs/faults.md.
