@@ -146,10 +146,14 @@ bool CcuApp::wait_for_corners(std::string& error) {
 void CcuApp::send_commands(std::uint64_t step, bool stop, bool log) {
   // The node's commands are in channel order, as commands_.
   const auto& cmds = node_.commands(step, stop, log);
-  // Cut off, or back from an outage: nothing. A command written while cut off would reach the
-  // corners when the link returns, before the lowered strength does, and they would take it
-  // (seen: FL applied such a command, computed with every corner lost, 0 kN, for 25 ms).
-  if (options_.standby && !stop && (cut_off_ || Clock::now() < quiet_until_)) return;
+  // Realtime, cut off or back from an outage: nothing. A command written while cut off would
+  // reach the corners when the link returns, before the lowered strength does, and they would
+  // take it (seen: FL applied such a command, computed with every corner lost, 0 kN, for 25 ms).
+  // Lockstep never: its commands are the grants the corners wait for, the two CCUs' are the same,
+  // and a corner takes none for a period it has done (both CCUs silent once deadlocked a run).
+  if (options_.standby && options_.mode == ClockMode::Realtime && !stop && (cut_off_ || Clock::now() < quiet_until_)) {
+    return;
+  }
   for (std::size_t i = 0; i < cmds.size(); ++i) commands_[i]->send(cmds[i]);
 }
 
@@ -436,8 +440,14 @@ int CcuApp::run(std::string& error) {
         const double quiet_s = std::chrono::duration<double>(now - last_block_at_).count();
         // A stall beyond the corners' command deadline is counted, not acted on: the corners go
         // to the other CCU for the stall and come back (the commands are the same; docs/faults.md).
-        if (last_send_ != Clock::time_point{} && send_gap_s > kOwnershipDeadline_s) ++failover_.stalls;
-        if (last_block_at_ != Clock::time_point{} && quiet_s > kCutOff_s && k + 4 < periods_ && !cut_off_) {
+        if (last_send_ != Clock::time_point{} && send_gap_s > kOwnershipDeadline_s) {
+          ++failover_.stalls;
+          last_stall_at_ = now;
+        }
+        // Cut off: no block for kCutOff_s while this CCU itself ran on time (a stall of the whole
+        // machine silences the corners too, and is no cut).
+        const bool ran_on_time = std::chrono::duration<double>(now - last_stall_at_).count() > kCutOff_s;
+        if (last_block_at_ != Clock::time_point{} && quiet_s > kCutOff_s && ran_on_time && k + 4 < periods_ && !cut_off_) {
           demote(t_k, "cut off from every corner");
           cut_off_ = true;  // one outage until a block arrives again
         }
