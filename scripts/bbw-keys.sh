@@ -4,7 +4,7 @@
 # Creates, with openssl only:
 #   DIR/ca/ca.pem, ca.key                 test CA (ECDSA P-256, self-signed)
 #   DIR/<id>/cert.pem, key.pem            identity of each process, signed by the CA
-#                                         (id = ccu fl fr rl rr; subject /C=DE/O=bbw/CN=bbw_<id>)
+#                                         (id = ccu ccu_standby fl fr rl rr; subject /C=DE/O=bbw/CN=bbw_<id>)
 #   DIR/governance.xml, governance.p7s    governance document, S/MIME-signed by the CA
 #   DIR/<id>/permissions.xml, .p7s        permissions of each identity, S/MIME-signed by the CA
 #   DIR/rogue/ca/...                      a rogue CA our CA never signed
@@ -43,7 +43,7 @@ mkdir -p "$DIR" || die "cannot create directory '$DIR'"
 DIR="$(cd "$DIR" && pwd)"
 umask 077
 
-IDS=(ccu fl fr rl rr)
+IDS=(ccu ccu_standby fl fr rl rr)
 DAYS=3650
 SUBJ_PREFIX="/C=DE/O=bbw"
 TOPIC_MEAS="bbw/MeasurementBlock"
@@ -225,8 +225,9 @@ governance_xml | write_if_changed "$DIR/governance.xml"
 sign_doc "$DIR/ca" "$DIR/governance.xml" "$DIR/governance.p7s"
 
 for id in "${IDS[@]}"; do
-  if [ "$id" = ccu ]; then
-    # Commands and calibration state in a run's partition run_<id> (issue 17) or none.
+  if [ "$id" = ccu ] || [ "$id" = ccu_standby ]; then
+    # Commands and calibration state in a run's partition run_<id> (issue 17) or none. The
+    # hot-standby CCU (issue 16) has its own identity and the same rights: only these two command.
     pub="$(rule publish "*" "$TOPIC_CMD" "$TOPIC_CAL")"
     sub="$(rule subscribe "corner_*" "$TOPIC_MEAS" "$TOPIC_HEALTH")"
   else

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <stdexcept>
 
 #include "bbw/dds/run_id.hpp"
@@ -20,10 +21,26 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-dds::ParticipantOptions named(dds::ParticipantOptions p) {
-  if (p.name.empty()) p.name = "bbw_ccu";
+dds::ParticipantOptions named(dds::ParticipantOptions p, const CcuOptions& o) {
+  if (p.name.empty()) p.name = o.standby && o.role == "standby" ? "bbw_ccu_standby" : "bbw_ccu";
   return p;
 }
+
+// A standby run's lockstep re-send interval: the corners' command deadline (10 ms), so the
+// standby's grant reaches a corner soon after the corner dropped a silent primary.
+constexpr auto kStandbyResend = std::chrono::milliseconds(10);
+// A CCU whose own commands were this far apart may have lost the corners' ownership to the other
+// CCU for a moment (a stall): the command deadline of the *_owned profiles.
+constexpr double kOwnershipDeadline_s = 0.010;
+// A CCU that heard no block from any corner this long is cut off (its link is down): longer than
+// the measurement deadline (15 ms), so one late period of every corner is not a cut.
+constexpr double kCutOff_s = 0.050;
+// After a long outage (continued after a stop, or its link back after a cut) a CCU sends no
+// command for this long: its state is stale, and its lowered strength must reach every corner
+// first. Fast DDS sends the strength by discovery, which a cut link delays: the corners took the
+// primary back for 550 ms after its link returned before they had its lowered strength.
+constexpr auto kRejoinQuiet = std::chrono::milliseconds(1000);
+
 
 // The first period that starts at or after time_s.
 std::uint64_t step_at(double time_s, double period_s) {
@@ -39,7 +56,7 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
       events_(events),
       node_(scenario, calibrator, options.friction_feedback, options.monitor),
       periods_(node_.periods()),
-      participant_(named(options.participant)),
+      participant_(named(options.participant, options)),
       // Calibration state in the run's partition; measurements, health and each corner's commands
       // in that corner's partition of this run (bbw/dds/run_id.hpp): another run on the domain
       // never matches, and a corner is woken only by its own command (not by all four).
@@ -51,13 +68,25 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
         security::corner_partition(static_cast<int>(node_.channel(i).slot)), options.participant.run_id)};
     blocks_.push_back(std::make_unique<BlockInlet>(
         participant_, dds::kMeasurementTopic,
-        dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_reader, events, partition));
+        dds::profiles_for(options.mode == ClockMode::Lockstep, options.standby).measurement_reader, events, partition));
     health_.push_back(std::make_unique<HealthInlet>(participant_, dds::kHealthTopic, "state_reader", events, partition));
     commands_.push_back(std::make_unique<CommandOutlet>(
-        participant_, dds::kCommandTopic, dds::profiles_for(options.mode == ClockMode::Lockstep).command_writer, events,
+        participant_, dds::kCommandTopic, dds::profiles_for(options.mode == ClockMode::Lockstep, options.standby).command_writer, events,
         partition));
   }
   instances_.resize(node_.channels());
+  if (options.standby && options.mode == ClockMode::Lockstep) {
+    stash_.resize(node_.channels());
+    for (Stash& s : stash_) {
+      for (Stash::Slot& slot : s.slots) slot.block.samples().reserve(msg::MAX_BLOCK_SAMPLES);
+    }
+  }
+  const faults::Target self = options.standby && options.role == "standby" ? faults::Target::CcuStandby : faults::Target::CCU;
+  if (options.standby) {
+    failover_.role = options.role;
+    failover_.strength_initial = dds::ccu_strength(options.role != "standby", 0);
+    set_strength(failover_.strength_initial);
+  }
   block_.samples().reserve(msg::MAX_BLOCK_SAMPLES);
   if (options.vehicle != nullptr) {
     const dds::Partition run{dds::run_partition(options.participant.run_id)};
@@ -73,8 +102,10 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
   }
   if (options.process_faults) {
     for (const faults::ProcessAction& a : faults::process_actions(options.schedule)) {
-      if (a.target == faults::Target::CCU) {
+      if (faults::is_ccu(a.target)) {
+        if (a.target != self) continue;  // the other CCU's
         if (a.kind == faults::ProcessAction::Kind::Kill && !kill_at_s_) kill_at_s_ = a.at_s;
+        if (a.kind == faults::ProcessAction::Kind::Hang && !hang_at_s_) hang_at_s_ = a.at_s;
       } else if (a.kind == faults::ProcessAction::Kind::Restart) {
         restarts_.emplace_back(step_at(a.at_s, scenario.ccu_period_s), *faults::corner_slot(a.target));
       }
@@ -152,7 +183,61 @@ bool CcuApp::wait_for_corners(std::string& error) {
 void CcuApp::send_commands(std::uint64_t step, bool stop, bool log) {
   // The node's commands are in channel order, as commands_.
   const auto& cmds = node_.commands(step, stop, log);
+  // Realtime, cut off or back from an outage: nothing. A command written while cut off would
+  // reach the corners when the link returns, before the lowered strength does, and they would
+  // take it (seen: FL applied such a command, computed with every corner lost, 0 kN, for 25 ms).
+  // Lockstep never: its commands are the grants the corners wait for, the two CCUs' are the same,
+  // and a corner takes none for a period it has done (both CCUs silent once deadlocked a run).
+  if (options_.standby && options_.mode == ClockMode::Realtime && !stop && (cut_off_ || Clock::now() < quiet_until_)) {
+    return;
+  }
   for (std::size_t i = 0; i < cmds.size(); ++i) commands_[i]->send(cmds[i]);
+}
+
+// dds::ccu_strength, 1 lower per re-announcement after a cut (at most 999: the order of the two
+// CCUs, steps of 1000, never changes by it).
+std::uint32_t CcuApp::strength() const {
+  return dds::ccu_strength(options_.role != "standby", failover_.outages) - std::min<std::uint32_t>(reannouncements_, 999);
+}
+
+void CcuApp::set_strength(std::uint32_t strength) {
+  for (auto& c : commands_) {
+    auto& w = c->get().get();
+    eprosima::fastdds::dds::DataWriterQos q = w.get_qos();
+    q.ownership_strength().value = strength;
+    if (w.set_qos(q) != ReturnCode_t::RETCODE_OK) {
+      throw dds::DdsError("cannot set the command writer's ownership strength to " + std::to_string(strength));
+    }
+  }
+  failover_.strength_final = strength;
+}
+
+void CcuApp::demote(double sim_s, const char* reason) {
+  if (!options_.standby) return;
+  ++failover_.outages;
+  set_strength(strength());
+  failover_.demoted_sim_s = sim_s;
+  failover_.demoted_mono_s = runtime::mono_now_s();
+  failover_.demote_reason = reason;
+  std::cout << "bbw_ccu (" << options_.role << "): lowered its command strength to " << failover_.strength_final
+            << " at " << sim_s << " s (" << reason << ")" << std::endl;
+}
+
+// The link is back after a cut: quiet for kRejoinQuiet, and the lowered strength announced again
+// (set while cut off, its discovery message may not have reached the corners: once they kept the
+// returned primary as the owner for the rest of the run). A strength 1 lower is a new value, so
+// Fast DDS announces it now; the order of the two CCUs (steps of 1000) does not change.
+void CcuApp::link_back() {
+  quiet_until_ = Clock::now() + kRejoinQuiet;
+  ++reannouncements_;
+  set_strength(strength());
+}
+
+void CcuApp::write_failover_stats() const {
+  if (!options_.standby || options_.out_dir.empty()) return;
+  runtime::CcuFailoverStats s = failover_;
+  s.periods_done = periods_done_;
+  runtime::save(s, options_.out_dir + "/ccu_failover.stats");
 }
 
 void CcuApp::send_calibration_updates() {
@@ -160,14 +245,58 @@ void CcuApp::send_calibration_updates() {
   node_.clear_calibration_updates();
 }
 
-void CcuApp::drain_blocks(double arrival_s) {
+void CcuApp::drain_blocks(double arrival_s, std::optional<std::uint64_t> step) {
   const bool realtime = options_.mode == ClockMode::Realtime;
   transport::EndpointId writer = 0;
+  if (step && options_.standby) {
+    drain_blocks_in_order(arrival_s, *step);
+    return;
+  }
   for (std::size_t i = 0; i < node_.channels(); ++i) {
     while (blocks_[i]->take(block_, writer)) {
+      last_block_at_ = Clock::now();
+      if (cut_off_) link_back();
+      cut_off_ = false;
       if (block_.corner_id() == node_.channel(i).slot) instances_[i] = blocks_[i]->last_info().instance_handle;
       node_.on_block(i, block_, writer, realtime ? realtime_now_s() : arrival_s);
       send_calibration_updates();
+    }
+  }
+}
+
+// Lockstep with a hot-standby CCU: the corners follow the grants of whichever CCU owns their
+// commands, so this CCU may be behind them (it started later, or it is slower) and find blocks
+// of later periods waiting. It takes them into the node in period order, each in its own period:
+// the two CCUs then compute the same thing from the same blocks whoever leads. The blocks of
+// later periods wait in a stash sized at construction.
+void CcuApp::drain_blocks_in_order(double arrival_s, std::uint64_t step) {
+  for (std::size_t i = 0; i < node_.channels(); ++i) {
+    Stash& s = stash_[i];
+    auto process = [&](const msg::MeasurementBlock& b, transport::EndpointId writer) {
+      last_block_at_ = Clock::now();
+      if (cut_off_) link_back();
+      cut_off_ = false;
+      node_.on_block(i, b, writer, arrival_s);
+      send_calibration_updates();
+    };
+    while (s.count > 0 && s.slots[s.head].block.block_seq() <= step) {
+      process(s.slots[s.head].block, s.slots[s.head].writer);
+      s.head = (s.head + 1) % s.slots.size();
+      --s.count;
+    }
+    transport::EndpointId writer = 0;
+    while (blocks_[i]->take(block_, writer)) {
+      if (block_.corner_id() == node_.channel(i).slot) instances_[i] = blocks_[i]->last_info().instance_handle;
+      if (block_.block_seq() <= step && s.count == 0) {
+        process(block_, writer);
+      } else if (s.count < s.slots.size()) {
+        Stash::Slot& slot = s.slots[(s.head + s.count) % s.slots.size()];
+        slot.block = block_;
+        slot.writer = writer;
+        ++s.count;
+      } else {
+        ++stash_overflows_;  // further behind than the stash holds: the block is lost to this CCU
+      }
     }
   }
 }
@@ -215,9 +344,28 @@ void CcuApp::freeze_for_kill(double at_s) {
   wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
   if (log_ != nullptr) log_->flush();
   if (!options_.out_dir.empty()) write_stats(options_.out_dir + "/ccu.stats");
+  failover_.failure = "kill";
+  failover_.failed_sim_s = at_s;
+  failover_.failed_mono_s = runtime::mono_now_s();
+  write_failover_stats();
   ::raise(SIGSTOP);
   // Continued instead of killed (nobody carried the kill out): stop without a word.
   ::_exit(kExitRuntime);
+}
+
+void CcuApp::freeze_for_hang(double at_s) {
+  // The scheduled hang (a standby run): stop dead like a kill, but the launcher leaves the
+  // process stopped (and continues it after resume_after_s, if given).
+  hang_at_s_.reset();
+  if (log_ != nullptr) log_->flush();
+  failover_.failure = "hang";
+  failover_.failed_sim_s = at_s;
+  failover_.failed_mono_s = runtime::mono_now_s();
+  write_failover_stats();
+  ::raise(SIGSTOP);
+  failover_.resumed_mono_s = runtime::mono_now_s();
+  demote(at_s, "resumed after a stop");
+  quiet_until_ = Clock::now() + kRejoinQuiet;
 }
 
 int CcuApp::run(std::string& error) {
@@ -225,17 +373,31 @@ int CcuApp::run(std::string& error) {
   // Initial model: every corner knows the thresholds and initial curve before period 0.
   for (const msg::CalibrationState& s : node_.initial_states()) calibration_.send(s);
   // The clock policy (bbw/runtime/period_clock.hpp): lockstep, period k begins when every
-  // live corner's block k is in; realtime, at t0 + k * T, inputs drained as they come.
-  const auto clock = runtime::make_period_clock(options_.mode, events_, scenario_.ccu_period_s, options_.peer_timeout,
-                                                /*poll_while_waiting=*/true);
+  // live corner's block k is in (commands re-sent on a stall); realtime, at t0 + k * T, inputs
+  // drained as they come.
+  const double T = scenario_.ccu_period_s;
+  const auto clock = runtime::make_period_clock(
+      options_.mode, events_, T, options_.peer_timeout, /*poll_while_waiting=*/true,
+      options_.standby ? Clock::duration(kStandbyResend) : Clock::duration(std::chrono::milliseconds(200)));
   clock->start(0);
   t0_ = clock->started_at();
+  failover_.t0_mono_s = std::chrono::duration<double>(t0_.time_since_epoch()).count();
   int rc = kExitOk;
+  bool retired = false;
   std::uint32_t expected_incarnation[kSlots] = {};
   if (options_.mode == ClockMode::Lockstep) {
     for (std::uint64_t k = 0; k < periods_ && !events_.interrupted(); ++k) {
       const double t_k = node_.period_start_s(k);
       if (kill_at_s_ && t_k >= *kill_at_s_ - 1e-9) freeze_for_kill(t_k);
+      if (hang_at_s_ && t_k >= *hang_at_s_ - 1e-9) {
+        freeze_for_hang(t_k);
+        // A lockstep CCU cannot rejoin the lock step after a stop (the corners went on under the
+        // other CCU; the blocks it missed are gone): it leaves the run.
+        std::cout << "bbw_ccu (" << options_.role << "): resumed after a hang in lockstep: leaves the run at " << t_k
+                  << " s" << std::endl;
+        retired = true;
+        break;
+      }
       for (const auto& [step, slot] : restarts_) {
         if (step != k) continue;
         for (std::size_t i = 0; i < node_.channels(); ++i) {
@@ -249,13 +411,24 @@ int CcuApp::run(std::string& error) {
       // A command is re-sent every 200 ms without progress: a corner that has just (re)joined
       // may have matched our writer only after it was sent.
       auto pred = [&] {
-        drain_blocks(t_end);
+        drain_blocks(t_end, k);
         drain_vehicle();
         drain_health();
         drain_qos_events(t_end, true);
         return node_.period_complete(k);
       };
-      const runtime::PeriodStart begun = clock->begin(k, pred, [&] { send_commands(k, false, false); });
+      const runtime::PeriodStart begun = clock->begin(k, pred, [&] {
+        // A standby run: no block from any corner for kCutOff_s of wall time while waiting is a
+        // cut link (the corners go on under the other CCU). Who leads never changes a lockstep
+        // log (both CCUs compute the same commands), so a slow machine mistaken for a cut costs
+        // nothing but the order of the two CCUs.
+        if (options_.standby && !cut_off_ && last_block_at_ != Clock::time_point{} &&
+            std::chrono::duration<double>(Clock::now() - last_block_at_).count() > kCutOff_s) {
+          demote(t_k, "cut off from every corner");
+          cut_off_ = true;
+        }
+        send_commands(k, false, false);
+      });
       const bool ok = begun == runtime::PeriodStart::Go;
       if (const std::string failed = node_.end_lockstep_period(k, t_end); !failed.empty()) {
         error = "corner " + failed + " reported failure at period " + std::to_string(k);
@@ -289,6 +462,38 @@ int CcuApp::run(std::string& error) {
       periods_done_ = k;
       if (k == periods_) break;
       if (kill_at_s_ && t_k >= *kill_at_s_ - 1e-9) freeze_for_kill(t_k);
+      if (hang_at_s_ && t_k >= *hang_at_s_ - 1e-9) {
+        freeze_for_hang(t_k);
+        // Resumed: go on from the period the wall clock is in (the missed ones are gone).
+        k = std::max(k, static_cast<std::uint64_t>(realtime_now_s() / T));
+        if (k >= periods_) break;
+        last_send_ = {};
+        last_block_at_ = Clock::now();
+        continue;
+      }
+      if (options_.standby) {
+        // Out of the loop long enough for the corners to drop this CCU as their owner: stalled
+        // (its own commands too far apart: counted), or cut off (no block from any corner: an
+        // outage, docs/faults.md "Who commands").
+        const auto now = Clock::now();
+        const double send_gap_s = std::chrono::duration<double>(now - last_send_).count();
+        const double quiet_s = std::chrono::duration<double>(now - last_block_at_).count();
+        // A stall beyond the corners' command deadline is counted, not acted on: the corners go
+        // to the other CCU for the stall and come back (the commands are the same; docs/faults.md).
+        if (last_send_ != Clock::time_point{} && send_gap_s > kOwnershipDeadline_s) {
+          ++failover_.stalls;
+          last_stall_at_ = now;
+        }
+        // Cut off: no block for kCutOff_s while this CCU itself ran on time (a stall of the whole
+        // machine silences the corners too, and is no cut).
+        const bool ran_on_time = std::chrono::duration<double>(now - last_stall_at_).count() > kCutOff_s;
+        if (last_block_at_ != Clock::time_point{} && quiet_s > kCutOff_s && ran_on_time && k + 4 < periods_ && !cut_off_) {
+          demote(t_k, "cut off from every corner");
+          cut_off_ = true;  // one outage until a block arrives again
+        }
+        // The gap to the next send starts now: the demotion's own time (set_qos) is not a stall.
+        last_send_ = Clock::now();
+      }
       send_commands(k, false);
     }
     // The last blocks: wait briefly for every corner that is still linked.
@@ -300,7 +505,16 @@ int CcuApp::run(std::string& error) {
     node_.record_detections();
   }
   wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
-  sim_s_ = static_cast<double>(periods_done_) * scenario_.ccu_period_s;
+  sim_s_ = static_cast<double>(periods_done_) * T;
+  write_failover_stats();
+  if (stash_overflows_ > 0) {
+    std::cerr << "bbw_ccu (" << options_.role << "): " << stash_overflows_
+              << " blocks lost: this CCU fell more than 1024 periods behind the corners" << std::endl;
+  }
+  if (retired) {
+    if (log_ != nullptr) log_->flush();
+    return rc;
+  }
   send_commands(periods_, true);
   for (auto& c : commands_) c->get().get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
   if (log_ != nullptr) log_->flush();

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "bbw/calibration/calibrator.hpp"
+#include "bbw/runtime/failover_stats.hpp"
 #include "bbw/runtime/process_cli.hpp"
 #include "bbw/dds/corner.hpp"
 #include "bbw/dds/events.hpp"
@@ -52,6 +53,10 @@ struct CcuOptions : runtime::ProcessOptions {
   // A vehicle run (issue 15, docs/vehicle.md): the vehicle and the pedal join the lockstep
   // barrier and the CCU's brake functions command the corners. nullptr: a four-corner run.
   const vehicle_run::VehicleScenario* vehicle = nullptr;
+  // With a hot-standby CCU (options.standby, issue 16): "primary" or "standby" (--role). Sets the
+  // participant name (bbw_ccu / bbw_ccu_standby), the command writers' ownership strength and
+  // which of the schedule's CCU faults (CCU / CCU_STANDBY) is this process's.
+  std::string role = "primary";
 };
 
 class CcuApp {
@@ -69,11 +74,22 @@ class CcuApp {
   bool wait_for_corners(std::string& error);
   void send_commands(std::uint64_t step, bool stop, bool log = true);
   void send_calibration_updates();
-  void drain_blocks(double arrival_s);
+  // `step`: lockstep, the period being waited for (with a standby: blocks go in in period order).
+  void drain_blocks(double arrival_s, std::optional<std::uint64_t> step = std::nullopt);
+  void drain_blocks_in_order(double arrival_s, std::uint64_t step);
   void drain_qos_events(double now_s, bool lockstep);
   void drain_health();
   bool wait_for_rejoin(std::size_t channel, std::uint32_t incarnation, std::string& error);
   [[noreturn]] void freeze_for_kill(double at_s);
+  // The scheduled hang: freezes (SIGSTOP) like a kill; returns when the launcher continues it.
+  void freeze_for_hang(double at_s);
+  // An outage (stopped and continued, cut off): lowers this CCU's command strength
+  // (dds::ccu_strength; docs/faults.md "Hand-back").
+  void demote(double sim_s, const char* reason);
+  std::uint32_t strength() const;
+  void set_strength(std::uint32_t strength);
+  void link_back();
+  void write_failover_stats() const;
   double realtime_now_s() const;
   void drain_vehicle();
 
@@ -103,6 +119,25 @@ class CcuApp {
   double sim_s_ = 0.0;
   std::uint64_t periods_done_ = 0;
   std::optional<double> kill_at_s_;                       // scheduled CCU kill
+  std::optional<double> hang_at_s_;                       // scheduled CCU hang (a standby run)
+  runtime::CcuFailoverStats failover_;                    // a standby run: role, strength, failure
+  std::chrono::steady_clock::time_point last_send_{};     // realtime, standby run: the last command send
+  std::chrono::steady_clock::time_point last_block_at_{}; // ... and the last block from any corner
+  bool cut_off_ = false;                                  // no block from any corner for kCutOff_s
+  std::chrono::steady_clock::time_point last_stall_at_{}; // realtime: its own last stall
+  std::chrono::steady_clock::time_point quiet_until_{};   // back from a long outage: no command until then
+  std::uint32_t reannouncements_ = 0;                     // strength announced again after a cut
+  // Lockstep with a standby: blocks of later periods than this CCU's, per corner (FIFO ring).
+  struct Stash {
+    struct Slot {
+      msg::MeasurementBlock block;
+      transport::EndpointId writer = 0;
+    };
+    std::array<Slot, 1024> slots;  // as deep as the measurement history (profile *_lockstep_standby)
+    std::size_t head = 0, count = 0;
+  };
+  std::vector<Stash> stash_;
+  std::uint64_t stash_overflows_ = 0;
   std::vector<std::pair<std::uint64_t, std::size_t>> restarts_;  // lockstep: (step, slot)
   // A vehicle run: the vehicle's and the pedal's readings, their barrier places, the brake functions.
   std::unique_ptr<dds::DdsInlet<msg::VehicleSensorsPubSubType>> vehicle_in_;

@@ -5,6 +5,11 @@
 //           [--discovery-timeout S] [--peer-timeout S] [--process-faults]
 //           [--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--secure KEYS_DIR]
 //           [--out DIR] [--calibrator FILE.yaml] [--monitor FILE.yaml] [--friction-feedback on|off]
+//           [--standby --role primary|standby]
+//
+// --standby --role: one of the two CCUs of a run with a hot-standby CCU (issue 16, docs/faults.md
+// "Hot-standby CCU"): commands under DDS exclusive ownership, the primary stronger; the standby
+// is the participant bbw_ccu_standby (with --secure, identity ccu_standby).
 //
 // The flags in the first three lines are bbw_corner's too (bbw/runtime/process_cli.hpp).
 //
@@ -30,6 +35,7 @@
 #include "bbw/faults/monitor_yaml.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/runtime/signals.hpp"
+#include "bbw/runtime/teardown_guard.hpp"
 #include "bbw/scenario/load.hpp"
 #include "bbw/security/dds_security.hpp"
 #include "bbw/vehicle_run/vehicle_scenario.hpp"
@@ -38,7 +44,8 @@
 namespace {
 
 std::string usage() {
-  return bbw::runtime::process_usage("bbw_ccu", "", {"[--out DIR] [--calibrator FILE.yaml] [--monitor FILE.yaml] [--friction-feedback on|off]"});
+  return bbw::runtime::process_usage("bbw_ccu", "", {"[--out DIR] [--calibrator FILE.yaml] [--monitor FILE.yaml] [--friction-feedback on|off]",
+                                                  "[--role primary|standby] (with --standby)"});
 }
 
 }  // namespace
@@ -52,6 +59,7 @@ int main(int argc, char** argv) {
   bbw::runtime::ProcessFlags flags;
   std::string calibrator_file;  // default: config/calibrator/robust.yaml of bbw's data (bbw/common/data_path.hpp)
   std::string monitor_file;     // default: config/faults/monitor.yaml
+  bool role_given = false;
   try {
     for (bbw::runtime::ArgCursor args(argc, argv); !args.done();) {
       const std::string k = args.flag();
@@ -59,6 +67,13 @@ int main(int argc, char** argv) {
       if (k == "--out") opt.out_dir = args.value();
       else if (k == "--calibrator") calibrator_file = args.value();
       else if (k == "--monitor") monitor_file = args.value();
+      else if (k == "--role") {
+        opt.role = args.value();
+        if (opt.role != "primary" && opt.role != "standby") {
+          throw std::invalid_argument("--role must be primary or standby, got '" + opt.role + "'");
+        }
+        role_given = true;
+      }
       else if (k == "--friction-feedback") {
         const std::string v = args.value();
         if (v != "on" && v != "off") throw std::invalid_argument("--friction-feedback must be on or off, got '" + v + "'");
@@ -68,6 +83,7 @@ int main(int argc, char** argv) {
       else throw std::invalid_argument("unknown argument '" + k + "'");
     }
     flags.finish(std::getenv("BBW_DOMAIN"));
+    if (role_given && !flags.options.standby) throw std::invalid_argument("--role needs --standby (a run with a hot-standby CCU)");
   } catch (const std::exception& e) {
     std::cerr << "bbw_ccu: " << e.what() << "\n" << usage();
     return kExitUsage;
@@ -83,7 +99,8 @@ int main(int argc, char** argv) {
   try {
     if (!secure_dir.empty()) {
       opt.participant.properties = bbw::security::participant_properties(
-          bbw::security::files_for(secure_dir, bbw::security::kCcuIdentity));
+          bbw::security::files_for(secure_dir, opt.standby && opt.role == "standby" ? bbw::security::kCcuStandbyIdentity
+                                                                                  : bbw::security::kCcuIdentity));
     }
     if (bbw::vehicle_run::is_vehicle_scenario(scenario_file)) {
       // A vehicle scenario (issue 15): its calipers, and the vehicle and pedal as participants.
@@ -122,6 +139,8 @@ int main(int argc, char** argv) {
               << scenario->name << ", " << scenario->corners.size() << " corners" << std::endl;
     rc = app.run(error);
     if (!opt.out_dir.empty()) app.write_stats(opt.out_dir + "/ccu.stats");
+    // A standby run: the results are written; Fast DDS's teardown gets 5 s (teardown_guard.hpp).
+    if (opt.standby) bbw::runtime::bound_teardown("bbw_ccu", std::chrono::milliseconds(5000), rc);
   } catch (const std::invalid_argument& e) {
     std::cerr << "bbw_ccu: " << e.what() << "\n";
     return kExitUsage;

@@ -22,6 +22,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Older than this, a command is stale in a hot-standby run (ten CCU periods).
+constexpr auto kStaleCommand = std::chrono::milliseconds(50);
+
 node::CornerNodeOptions node_options(const CornerOptions& o) {
   node::CornerNodeOptions n;
   n.corner = o.corner;
@@ -32,6 +35,7 @@ node::CornerNodeOptions node_options(const CornerOptions& o) {
   n.incarnation = o.incarnation;
   n.resume_at_s = o.resume_at_s;
   n.run_id = o.participant.run_id;
+  n.standby = o.standby;
   return n;
 }
 
@@ -57,7 +61,7 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       // bbw/dds/run_id.hpp), secure or not: the permissions grant a corner only its own
       // (docs/security.md). Its commands come in that partition too (the CCU writes each corner's there), calibration state in the run's partition run_<id>.
       blocks_(participant_, dds::kMeasurementTopic,
-              dds::profiles_for(options.mode == ClockMode::Lockstep).measurement_writer, events,
+              dds::profiles_for(options.mode == ClockMode::Lockstep, options.standby).measurement_writer, events,
               dds::Partition{own_partition(options)}),
       health_(participant_, dds::kHealthTopic, "state_writer", events, dds::Partition{own_partition(options)}),
       // No DDS content filter on these topics: Fast DDS 2.9 evaluates DDS-SQL filters on the
@@ -65,10 +69,11 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
       // sample and made the CCU's command writes its largest cost. The node drops the other
       // corners' samples instead (4 commands per period, a few bytes each).
       commands_(participant_, dds::kCommandTopic,
-                dds::profiles_for(options.mode == ClockMode::Lockstep).command_reader, events,
+                dds::profiles_for(options.mode == ClockMode::Lockstep, options.standby).command_reader, events,
                 dds::Partition{own_partition(options)}),
       calibration_(participant_, dds::kCalibrationTopic, "state_reader", events,
-                   dds::Partition{dds::run_partition(options.participant.run_id)}) {
+                   dds::Partition{dds::run_partition(options.participant.run_id)}),
+      owners_(scenario.ccu_period_s) {
   if (options.vehicle) {
     vehicle_in_ = std::make_unique<dds::DdsInlet<msg::VehicleSensorsPubSubType>>(
         participant_, dds::kVehicleSensorsTopic, dds::profiles_for(true).measurement_reader, events,
@@ -86,12 +91,13 @@ void CornerApp::publish_health(std::uint8_t status) { health_.send(node_.health(
 
 bool CornerApp::wait_for_ccu(std::string& error) {
   const auto timeout = options_.match_timeout.count() > 0 ? options_.match_timeout : options_.discovery_timeout;
+  const int ccus = options_.standby ? 2 : 1;  // a hot-standby run: both CCUs before the start
   const bool ok = events_.wait_for(timeout, [&] {
     // A vehicle run: the vehicle reads our blocks too (its reader must have matched before block 0,
-    // which is not sent again), and we read its sensors.
-    const int block_readers = vehicle_in_ == nullptr ? 1 : 2;
-    return blocks_.peers() >= block_readers && commands_.peers() >= 1 && calibration_.peers() >= 1 &&
-           health_.peers() >= 1 && (vehicle_in_ == nullptr || vehicle_in_->peers() >= 1);
+    // which is not sent again), and we read its sensors. A hot-standby run: both CCUs.
+    const int block_readers = ccus + (vehicle_in_ == nullptr ? 0 : 1);
+    return blocks_.peers() >= block_readers && commands_.peers() >= ccus && calibration_.peers() >= ccus &&
+           health_.peers() >= ccus && (vehicle_in_ == nullptr || vehicle_in_->peers() >= 1);
   });
   matched_ccu_ = ok;
   if (!ok && !events_.interrupted()) {
@@ -118,9 +124,35 @@ corner::CommandSource CornerApp::command_source() const {
     std::array<std::uint8_t, 12> prefix{};
     std::copy_n(source.writer.begin(), prefix.size(), prefix.begin());
     const auto tag = participant_.peer_tag(prefix);
-    source.announced_as_ccu = tag && tag->run_id == participant_.run_id() && tag->name == "bbw_ccu";
+    source.announced_as_ccu = tag && tag->run_id == participant_.run_id() &&
+                              (tag->name == "bbw_ccu" || (options_.standby && tag->name == "bbw_ccu_standby"));
   }
   return source;
+}
+
+// A hot-standby run, realtime: a command written more than kStaleCommand ago (by its source
+// timestamp: the same system clock on this host and in its network namespaces) is not taken.
+// After a cut, the returning CCU's last command arrives when the link comes back, and DDS may let
+// it through before the CCU's lowered strength has arrived (docs/faults.md, "Who commands").
+bool CornerApp::stale(const eprosima::fastdds::dds::SampleInfo& info) const {
+  const auto written = std::chrono::system_clock::time_point(std::chrono::duration_cast<std::chrono::system_clock::duration>(
+      std::chrono::nanoseconds(info.source_timestamp.to_ns())));
+  return std::chrono::system_clock::now() - written > kStaleCommand;
+}
+
+// The role of a command's writer, from its participant's announced name (cached per writer).
+runtime::CommandRole CornerApp::command_role(const std::array<std::uint8_t, 16>& writer) {
+  if (have_role_ && writer == role_writer_) return role_;
+  std::array<std::uint8_t, 12> prefix{};
+  std::copy_n(writer.begin(), prefix.size(), prefix.begin());
+  const auto tag = participant_.peer_tag(prefix);
+  role_ = !tag ? runtime::CommandRole::Unknown
+        : tag->name == "bbw_ccu" ? runtime::CommandRole::Primary
+        : tag->name == "bbw_ccu_standby" ? runtime::CommandRole::Standby
+                                         : runtime::CommandRole::Unknown;
+  role_writer_ = writer;
+  have_role_ = true;
+  return role_;
 }
 
 bool CornerApp::ccu_gone() const {
@@ -133,9 +165,24 @@ void CornerApp::drain_inputs() {
   transport::EndpointId from = 0;
   while (commands_.take(command_in_, from)) {
     if (command_in_.corner_id() != dds::corner_index(options_.corner)) continue;  // another corner's
-    node_.on_command(command_in_, command_source(), started_ ? sim_now_s() : 0.0);
+    if (options_.standby && options_.mode == ClockMode::Realtime && stale(commands_.last_info())) {
+      ++stale_commands_;  // written too long ago: a returning CCU's last command, redelivered
+      continue;
+    }
+    const corner::CommandSource source = command_source();
+    const std::uint64_t taken_before = node_.stats().commands_taken;
+    node_.on_command(command_in_, source, started_ ? sim_now_s() : 0.0);
+    if (options_.standby && node_.stats().commands_taken != taken_before) {
+      owners_.on_command(command_role(source.writer), command_in_.step(), command_in_.time_s(), runtime::mono_now_s());
+    }
   }
-  while (calibration_.take(state_in_)) node_.on_calibration(state_in_);
+  transport::EndpointId cal_from = 0;
+  while (calibration_.take(state_in_, cal_from)) {
+    node_.on_calibration(state_in_);
+    if (options_.standby && calibration_writers_ < 2 && cal_from != calibration_writer_[0]) {
+      calibration_writer_[calibration_writers_++] = cal_from;
+    }
+  }
   if (vehicle_in_ == nullptr) return;
   const std::size_t slot = dds::corner_index(options_.corner);
   while (vehicle_in_->take(vehicle_msg_)) {
@@ -158,6 +205,20 @@ void CornerApp::finish_stats(Clock::time_point wall0) {
   s.write_failures = failures_before;
   s.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   if (periods_log_ != nullptr) periods_log_->flush();
+  write_failover_stats();
+}
+
+// A hot-standby run: whose commands this corner applied, next to its stats file
+// (corner_FL.stats -> corner_FL_failover.stats).
+void CornerApp::write_failover_stats() const {
+  if (!options_.standby || options_.stats_file.empty()) return;
+  std::string file = options_.stats_file;
+  const std::string ext = ".stats";
+  if (file.size() > ext.size() && file.compare(file.size() - ext.size(), ext.size(), ext) == 0) file.resize(file.size() - ext.size());
+  runtime::CornerFailoverStats s = owners_.stats();
+  s.corner = dds::corner_name(options_.corner);
+  s.commands_stale = stale_commands_;
+  runtime::save(s, file + "_failover.stats");
 }
 
 void CornerApp::freeze_for_kill() {
@@ -182,7 +243,10 @@ int CornerApp::run(std::string& error) {
       publish_health(msg::HEALTH_STARTING);
       republish = Clock::now() + std::chrono::milliseconds(200);
     }
-    return node_.have_command();
+    // Lockstep with a hot-standby CCU: both CCUs have begun (each sends its initial calibration
+    // states just before its first command), so neither starts far behind the corners.
+    const bool both_ccus = !options_.standby || options_.mode != ClockMode::Lockstep || calibration_writers_ >= 2;
+    return node_.have_command() && both_ccus;
   });
   if (!started) {
     if (events_.interrupted()) return kExitOk;

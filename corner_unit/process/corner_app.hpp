@@ -6,6 +6,7 @@
 #include <bbw/idl/bbw_msgsPubSubTypes.h>
 #include <bbw/idl/bbw_vehicle_msgsPubSubTypes.h>
 
+#include <array>
 #include <chrono>
 #include <memory>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "bbw/runtime/command_owner.hpp"
 #include "bbw/runtime/process_cli.hpp"
 #include "bbw/dds/convert.hpp"
 #include "bbw/dds/corner.hpp"
@@ -95,6 +97,9 @@ class CornerApp {
   double sim_now_s() const;  // realtime: the corner's simulated time from the wall clock
   bool ccu_gone() const;     // the CCU's command writer lost its liveliness
   corner::CommandSource command_source() const;
+  runtime::CommandRole command_role(const std::array<std::uint8_t, 16>& writer);
+  bool stale(const eprosima::fastdds::dds::SampleInfo& info) const;
+  void write_failover_stats() const;
   [[noreturn]] void freeze_for_kill();
   void finish_stats(std::chrono::steady_clock::time_point wall0);
 
@@ -119,6 +124,14 @@ class CornerApp {
   double jitter_sum_s_ = 0.0;
   msg::ClampCommand command_in_;
   msg::CalibrationState state_in_;
+  // A hot-standby run (issue 16): whose commands were applied, and the role of the last writer.
+  runtime::CommandOwnerTracker owners_;
+  std::array<std::uint8_t, 16> role_writer_{};
+  runtime::CommandRole role_ = runtime::CommandRole::Unknown;
+  bool have_role_ = false;
+  std::array<transport::EndpointId, 2> calibration_writer_{};  // the CCUs heard on CalibrationState
+  std::size_t calibration_writers_ = 0;
+  std::uint64_t stale_commands_ = 0;  // realtime standby run: commands dropped as written too long ago
 };
 
 }  // namespace bbw::corner_process

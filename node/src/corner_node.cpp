@@ -40,8 +40,9 @@ faults::Target target_of(Corner c) { return static_cast<faults::Target>(corner_i
 
 // The caliper's rated clamp force from the plant config; the rate allows the full range in one
 // CCU period.
-corner::CommandGateParams gate_params(const scenario::Scenario& s) {
+corner::CommandGateParams gate_params(const scenario::Scenario& s, bool standby) {
   corner::CommandGateParams p;
+  p.max_sources = standby ? 2 : 1;
   p.max_force_kN = s.plant.rated_clamp_force_kN;
   p.max_rate_kN_per_s = p.max_force_kN / s.ccu_period_s;
   return p;
@@ -56,7 +57,7 @@ CornerNode::CornerNode(const scenario::Scenario& scenario, const CornerNodeOptio
       steps_per_period_(steps_per_period(scenario)),
       periods_(periods_of(scenario)),
       my_id_(static_cast<std::uint8_t>(corner_index(options.corner))),
-      gate_(options.run_id, gate_params(scenario)),
+      gate_(options.run_id, gate_params(scenario, options.standby)),
       injector_(options.schedule, target_of(options.corner),
                 scenario::corner_seed(scenario.seed + 7777, options.scenario_index)),
       link_(options.schedule, target_of(options.corner)),
@@ -98,12 +99,23 @@ void CornerNode::on_command(const msg::ClampCommand& cmd, const corner::CommandS
   if (!gated.applies()) return;
   const double force_kN = cmd.mode() == msg::MODE_FORCE ? gated.force_kN : cmd.clamp_force_kN();
   ++stats_.commands_received;
+  // A run with a hot-standby CCU: each CCU numbers its own commands, so the numbering starts
+  // again at a change of writer (DDS exclusive ownership changed hands).
+  const bool new_writer = options_.standby && have_command_ && source.writer != last_writer_;
+  if (new_writer) last_command_seq_.reset();
+  last_writer_ = source.writer;
   if (last_command_seq_ && cmd.seq() != *last_command_seq_ + 1) {
     stats_.command_seq_gaps += cmd.seq() > *last_command_seq_ ? cmd.seq() - *last_command_seq_ - 1 : 1;
   }
   last_command_seq_ = cmd.seq();
   if (cmd.step() < resume_step_ && !cmd.stop()) return;  // a restarted corner joins at its resume step
-  if (!have_command_ || cmd.step() >= latest_command_.step()) {
+  // Realtime: a takeover's command may name an earlier period (the two CCUs' clocks start apart);
+  // it is taken all the same (DDS ownership chose its writer). A stale one (a returning CCU's
+  // last command, delivered again by reliability) never gets here: the adapter drops commands
+  // written too long ago (CornerApp::drain_inputs).
+  const bool takeover = new_writer && !options_.lockstep;
+  if (!have_command_ || cmd.step() >= latest_command_.step() || takeover) {
+    ++stats_.commands_taken;
     latest_command_ = cmd;
     latest_command_.clamp_force_kN(force_kN);
     have_command_ = true;

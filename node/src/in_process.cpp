@@ -30,6 +30,10 @@ InProcessRun::InProcessRun(const scenario::Scenario& scenario, const calibration
     : scenario_(scenario),
       options_(options),
       ccu_(scenario, calibrator, options.friction_feedback, options.monitor, options.reactions) {
+  if (options.schedule.standby) {
+    throw std::invalid_argument(scenario.file + ": a hot-standby CCU (standby: true) runs only over DDS (./bbw run): "
+                                "it rests on DDS exclusive ownership");
+  }
   const auto actions = faults::process_actions(options.schedule);
   if (!actions.empty() && !options.process_faults) {
     throw std::invalid_argument(scenario.file + ": process faults (kill, restart) are carried out only with "

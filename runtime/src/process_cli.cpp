@@ -46,6 +46,7 @@ bool ProcessFlags::take(const std::string& flag, ArgCursor& args) {
   else if (flag == "--dds-participant-profile") options.participant.profile = args.value();
   else if (flag == "--secure") secure_dir = args.value();
   else if (flag == "--process-faults") options.process_faults = true;
+  else if (flag == "--standby") options.standby = true;
   else if (flag == "--run-id") {
     const std::string text = args.value();
     const auto id = dds::parse_run_id(text);
@@ -65,7 +66,7 @@ std::string process_usage(const std::string& program, const std::string& lead,
                           const std::vector<std::string>& own_lines) {
   const std::string pad(std::string("usage: ").size() + program.size() + 1, ' ');
   std::string text = "usage: " + program + (lead.empty() ? "" : " " + lead) + " --scenario FILE [--domain N] [--mode lockstep|realtime]\n" + pad +
-                     "[--discovery-timeout S] [--peer-timeout S] [--process-faults] [--run-id HEX]\n" + pad +
+                     "[--discovery-timeout S] [--peer-timeout S] [--process-faults] [--run-id HEX] [--standby]\n" + pad +
                      "[--dds-profiles FILE.xml] [--dds-participant-profile NAME] [--secure KEYS_DIR]\n";
   for (const std::string& line : own_lines) text += pad + line + "\n";
   return text;

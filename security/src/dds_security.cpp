@@ -54,7 +54,7 @@ std::string corner_partition(int corner_id) { return "corner_" + checked_corner_
 
 SecurityFiles files_for(const std::string& keys_dir, const std::string& identity) {
   if (std::find(identities().begin(), identities().end(), identity) == identities().end()) {
-    throw SecurityError("unknown identity '" + identity + "': must be one of ccu, fl, fr, rl, rr");
+    throw SecurityError("unknown identity '" + identity + "': must be one of ccu, ccu_standby, fl, fr, rl, rr");
   }
   if (keys_dir.empty()) throw SecurityError("no keys directory given (create one with: ./bbw keys DIR)");
   const std::filesystem::path dir(keys_dir);

@@ -118,3 +118,52 @@ TEST(CommandGate, RefusesAForceThatIsNoNumber) {
 }
 
 }  // namespace
+
+// A hot-standby run (issue 16): the gate pins the first two writers announced as this run's
+// CCUs, refuses a third, and limits a takeover's first command to the rated range only (the
+// other CCU's period clock is its own).
+namespace {
+
+TEST(CommandGate, WithAStandbyPinsTwoCcuWritersAndNoThird) {
+  CommandGateParams p = params();
+  p.max_sources = 2;
+  CommandGate gate(kRun, p);
+  EXPECT_EQ(gate.check(from(1), true, 10.0, 0.100).verdict, GateVerdict::Accepted);
+  EXPECT_FALSE(gate.pinned());
+  EXPECT_EQ(gate.check(from(2), true, 10.0, 0.100).verdict, GateVerdict::Accepted);
+  EXPECT_TRUE(gate.pinned());
+  EXPECT_EQ(gate.check(from(3), true, 10.0, 0.105).verdict, GateVerdict::RefusedSource);
+  EXPECT_EQ(gate.check(from(4, kRun, false), true, 10.0, 0.105).verdict, GateVerdict::RefusedSource);
+  EXPECT_EQ(gate.check(from(1), true, 10.0, 0.105).verdict, GateVerdict::Accepted);
+  EXPECT_EQ(gate.counts().refused_source, 2u);
+  // One source only (no standby): the second announced writer is refused, as before.
+  CommandGate single(kRun, params());
+  EXPECT_EQ(single.check(from(1), true, 10.0, 0.100).verdict, GateVerdict::Accepted);
+  EXPECT_EQ(single.check(from(2), true, 10.0, 0.105).verdict, GateVerdict::RefusedSource);
+}
+
+TEST(CommandGate, ATakeoverIsLimitedToTheRangeNotByTheOtherClock) {
+  CommandGateParams p = params();
+  p.max_rate_kN_per_s = 100.0;  // 0.5 kN per 5 ms
+  p.max_sources = 2;
+  CommandGate gate(kRun, p);
+  EXPECT_EQ(gate.check(from(1), true, 10.0, 1.000).verdict, GateVerdict::Accepted);
+  // The standby's clock is 3 ms behind: its command names an earlier period. Without the
+  // takeover rule no change would be allowed; with it, the range is the only limit.
+  const auto r = gate.check(from(2), true, 12.0, 0.997);
+  EXPECT_EQ(r.verdict, GateVerdict::Accepted);
+  EXPECT_DOUBLE_EQ(r.force_kN, 12.0);
+  // Then the rate holds again for that writer.
+  const auto next = gate.check(from(2), true, 20.0, 1.002);
+  EXPECT_EQ(next.verdict, GateVerdict::Clamped);
+  EXPECT_NEAR(next.force_kN, 12.5, 1e-9);
+  EXPECT_THROW(
+      [] {
+        CommandGateParams bad;
+        bad.max_sources = 3;
+        bad.validate();
+      }(),
+      std::invalid_argument);
+}
+
+}  // namespace

@@ -40,11 +40,20 @@ std::string key_of_error(const std::string& faults) {
 
 TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
   std::set<FaultType> types;
-  std::size_t files = 0;
+  std::size_t files = 0, standby_files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(test::source_path("config/scenarios/faults"))) {
     if (entry.path().extension() != ".yaml") continue;
-    ++files;
     const auto fs = load_fault_scenario(entry.path().string());
+    if (fs.faults.standby) {  // the hot-standby CCU's failover scenarios (issue 16): CCU faults only
+      ++standby_files;
+      EXPECT_EQ(entry.path().filename().string().rfind("ccu_failover_", 0), 0u) << entry.path();
+      for (const auto& f : fs.faults.faults) {
+        EXPECT_TRUE(is_ccu(f.target)) << entry.path();
+        types.insert(f.type);
+      }
+      continue;
+    }
+    ++files;
     if (fs.scenario.name == "fault_free_stop") {
       EXPECT_TRUE(fs.faults.empty());
     } else {
@@ -53,7 +62,8 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
     }
   }
   EXPECT_EQ(files, 15u);
-  EXPECT_EQ(types.size(), 12u);  // every FaultType; stuck appears for both sensors
+  EXPECT_EQ(standby_files, 4u);  // ccu_failover_{kill,hang,link_cut,both_lost}
+  EXPECT_EQ(types.size(), 14u);  // every FaultType; stuck appears for both sensors
 }
 
 TEST(FaultSchedule, ReadsEachTypeWithItsParameters) {
@@ -89,7 +99,8 @@ TEST(FaultSchedule, RejectsWhatIsWrongNamingKeyAndRule) {
             std::string::npos);
   EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: FL, part: load_cell, type: stuck, extra: 1}\n").find("faults[0].extra"),
             std::string::npos);
-  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: CCU, part: network, type: silence, duration_s: 1}\n").find("faults[0].part"),
+  // A CCU's only network fault is link_cut (a hot-standby run, issue 16).
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: CCU, part: network, type: silence, duration_s: 1}\n").find("faults[0].type"),
             std::string::npos);
   EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: FL, part: network, type: silence}\n").find("faults[0].duration_s"),
             std::string::npos);
@@ -102,6 +113,49 @@ TEST(FaultSchedule, RejectsWhatIsWrongNamingKeyAndRule) {
   EXPECT_NE(key_of_error("faults:\n  - {at_s: 2.5, corner: FL, part: load_cell, type: stuck}\n").find("faults[0].at_s"),
             std::string::npos);
   EXPECT_NE(key_of_error("faults:\n  - {at_s: -1, corner: FL, part: load_cell, type: stuck}\n").find("faults[0].at_s"),
+            std::string::npos);
+}
+
+TEST(FaultSchedule, HotStandbyFaultsAndTheStandbyKey) {
+  const auto fs = parse(R"(standby: true
+faults:
+  - {at_s: 0.5, corner: CCU, part: process, type: hang, resume_after_s: 0.25}
+  - {at_s: 0.6, corner: CCU, part: network, type: link_cut, duration_s: 0.3}
+  - {at_s: 0.9, corner: CCU_STANDBY, part: process, type: kill}
+)");
+  EXPECT_TRUE(fs.faults.standby);
+  ASSERT_EQ(fs.faults.faults.size(), 3u);
+  EXPECT_EQ(fs.faults.faults[0].type, FaultType::Hang);
+  EXPECT_DOUBLE_EQ(fs.faults.faults[0].end_s(), 0.75);
+  EXPECT_EQ(fs.faults.faults[1].type, FaultType::LinkCut);
+  EXPECT_EQ(part_of(FaultType::LinkCut), Part::Network);
+  EXPECT_DOUBLE_EQ(fs.faults.faults[1].end_s(), 0.9);
+  EXPECT_EQ(fs.faults.faults[2].target, Target::CcuStandby);
+  EXPECT_STREQ(to_string(Target::CcuStandby), "CCU_STANDBY");
+  const auto acts = process_actions(fs.faults);  // a link cut is no process action
+  ASSERT_EQ(acts.size(), 3u);
+  EXPECT_EQ(acts[0].kind, ProcessAction::Kind::Hang);
+  EXPECT_EQ(acts[1].kind, ProcessAction::Kind::Resume);
+  EXPECT_DOUBLE_EQ(acts[1].at_s, 0.75);
+  EXPECT_EQ(acts[2].kind, ProcessAction::Kind::Kill);
+  EXPECT_EQ(acts[2].target, Target::CcuStandby);
+  EXPECT_FALSE(parse("faults: []\n").faults.standby);
+
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: CCU_STANDBY, part: process, type: kill}\n")
+                .find("faults[0].corner | CCU_STANDBY needs a standby CCU"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("standby: yes please\n").find("standby"), std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: FL, part: process, type: hang}\n").find("faults[0].type"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: RR, part: network, type: link_cut}\n").find("faults[0].type"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: CCU, part: process, type: hang, duration_s: 1}\n")
+                .find("resume_after_s"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: CCU, part: process, type: kill, restart_after_s: 1}\n")
+                .find("faults[0].restart_after_s | a CCU is not restarted"),
+            std::string::npos);
+  EXPECT_NE(key_of_error("faults:\n  - {at_s: 0.5, corner: CCU, part: load_cell, type: stuck}\n").find("faults[0].part"),
             std::string::npos);
 }
 

@@ -30,6 +30,7 @@
 
 #include "bbw/runtime/child.hpp"
 #include "bbw/runtime/stats_file.hpp"
+#include "netns_support.hpp"
 
 namespace {
 
@@ -40,7 +41,6 @@ using bbw::runtime::Clock;
 
 constexpr int kDomain = 228;
 const std::vector<std::string> kCorners = {"FL", "FR", "RL", "RR"};
-constexpr const char* kNsPrefix = "bbwnt";  // bbwnt<pid>_<role>
 
 std::string src(const std::string& rel) { return std::string(BBW_TEST_SOURCE_DIR) + "/" + rel; }
 std::string bin(const std::string& name) { return std::string(BBW_TEST_BINARY_DIR) + "/bin/" + name; }
@@ -52,103 +52,8 @@ std::string slurp(const std::string& file) {
   return ss.str();
 }
 
-std::string ip_binary() {
-  for (const char* p : {"/usr/sbin/ip", "/sbin/ip", "/usr/bin/ip", "/bin/ip"}) {
-    if (::access(p, X_OK) == 0) return p;
-  }
-  return {};
-}
+using namespace bbw::netns_test;
 
-struct CmdResult {
-  bool ok = false;
-  std::string what;  // the command, its exit and stderr when it failed
-};
-
-// Runs `ip ARGS...` bounded by 5 s; output in `dir`.
-CmdResult ip(const std::string& dir, const std::vector<std::string>& args) {
-  std::vector<std::string> argv{ip_binary()};
-  argv.insert(argv.end(), args.begin(), args.end());
-  std::string cmd;
-  for (const auto& a : argv) cmd += (cmd.empty() ? "" : " ") + a;
-  Child c("ip", argv, dir + "/ip.out", dir + "/ip.err");
-  auto st = c.wait_until(Clock::now() + 5s);
-  if (!st) st = c.stop(500ms);
-  if (st->ok()) return {true, cmd};
-  return {false, cmd + ": " + st->describe() + ": " + slurp(dir + "/ip.err")};
-}
-
-// Owns the namespaces; deleting a namespace deletes the veth ends and the bridge inside it, and
-// a veth pair goes with either end.
-class Namespaces {
- public:
-  explicit Namespaces(std::string dir) : dir_(std::move(dir)) {}
-  ~Namespaces() {
-    for (auto it = names_.rbegin(); it != names_.rend(); ++it) ip(dir_, {"netns", "del", *it});
-  }
-  Namespaces(const Namespaces&) = delete;
-  Namespaces& operator=(const Namespaces&) = delete;
-
-  CmdResult add(const std::string& name) {
-    CmdResult r = ip(dir_, {"netns", "add", name});
-    if (r.ok) names_.push_back(name);
-    return r;
-  }
-
-  // Namespaces of an earlier run of this test that was killed before its guard ran.
-  static void remove_orphans(const std::string& dir) {
-    std::error_code ec;
-    for (const auto& e : fs::directory_iterator("/run/netns", fs::directory_options::skip_permission_denied, ec)) {
-      const std::string n = e.path().filename().string();
-      if (n.rfind(kNsPrefix, 0) != 0) continue;
-      const std::string pid = n.substr(std::string(kNsPrefix).size(), n.find('_') - std::string(kNsPrefix).size());
-      if (pid.empty() || fs::exists("/proc/" + pid)) continue;
-      ip(dir, {"netns", "del", n});
-    }
-  }
-
- private:
-  std::string dir_;
-  std::vector<std::string> names_;
-};
-
-// bbw_profiles.xml plus a UDPv4 transport allowed on `address` only and a participant profile
-// `bbw_netns` that uses it, with the other namespaces' addresses as unicast initial peers.
-std::string netns_profiles(const std::string& address, const std::vector<std::string>& peers) {
-  std::string xml = slurp(src("config/dds/bbw_profiles.xml"));
-  const std::string transport =
-      "      <transport_descriptor>\n"
-      "        <transport_id>bbw_udp_netns</transport_id>\n"
-      "        <type>UDPv4</type>\n"
-      "        <interfaceWhiteList><address>" + address + "</address></interfaceWhiteList>\n"
-      "        <maxInitialPeersRange>4</maxInitialPeersRange>\n"
-      "      </transport_descriptor>\n";
-  std::string locators;
-  for (const auto& p : peers) locators += "            <locator><udpv4><address>" + p + "</address></udpv4></locator>\n";
-  const std::string participant =
-      "    <participant profile_name=\"bbw_netns\">\n"
-      "      <rtps>\n"
-      "        <builtin>\n"
-      "          <discovery_config>\n"
-      "            <leaseDuration><sec>2</sec></leaseDuration>\n"
-      "            <leaseAnnouncement><sec>0</sec><nanosec>200000000</nanosec></leaseAnnouncement>\n"
-      "            <initialAnnouncements><count>5</count><period><sec>0</sec><nanosec>30000000</nanosec></period>"
-      "</initialAnnouncements>\n"
-      "          </discovery_config>\n"
-      "          <initialPeersList>\n" + locators +
-      "          </initialPeersList>\n"
-      "        </builtin>\n"
-      "        <useBuiltinTransports>false</useBuiltinTransports>\n"
-      "        <userTransports><transport_id>bbw_udp_netns</transport_id></userTransports>\n"
-      "      </rtps>\n"
-      "    </participant>\n";
-  const auto td = xml.find("</transport_descriptors>");
-  if (td == std::string::npos) return {};
-  xml.insert(td, transport);
-  const auto pe = xml.find("</profiles>");
-  if (pe == std::string::npos) return {};
-  xml.insert(pe, participant);
-  return xml;
-}
 
 // ccu_periods.csv as far as it has been written: (time_s, FL available) per complete line.
 struct PeriodRow {

@@ -31,6 +31,11 @@ bool LinkFaults::killed(double time_s) const {
 std::vector<ProcessAction> process_actions(const FaultSchedule& schedule) {
   std::vector<ProcessAction> out;
   for (const FaultSpec& f : schedule.faults) {
+    if (f.type == FaultType::Hang) {
+      out.push_back({f.at_s, f.target, ProcessAction::Kind::Hang});
+      if (f.resume_after_s) out.push_back({f.at_s + *f.resume_after_s, f.target, ProcessAction::Kind::Resume});
+      continue;
+    }
     if (f.type != FaultType::Kill) continue;
     out.push_back({f.at_s, f.target, ProcessAction::Kind::Kill});
     if (f.restart_after_s) out.push_back({f.at_s + *f.restart_after_s, f.target, ProcessAction::Kind::Restart});

@@ -8,6 +8,9 @@ double FaultSpec::end_s() const {
   if (type == FaultType::Kill) {
     return restart_after_s ? at_s + *restart_after_s : std::numeric_limits<double>::infinity();
   }
+  if (type == FaultType::Hang) {
+    return resume_after_s ? at_s + *resume_after_s : std::numeric_limits<double>::infinity();
+  }
   return duration_s ? at_s + *duration_s : std::numeric_limits<double>::infinity();
 }
 
@@ -28,6 +31,7 @@ const char* to_string(Target t) {
     case Target::RL: return "RL";
     case Target::RR: return "RR";
     case Target::CCU: return "CCU";
+    case Target::CcuStandby: return "CCU_STANDBY";
   }
   return "?";
 }
@@ -57,6 +61,8 @@ const char* to_string(FaultType t) {
     case FaultType::Silence: return "silence";
     case FaultType::Delay: return "delay";
     case FaultType::Kill: return "kill";
+    case FaultType::Hang: return "hang";
+    case FaultType::LinkCut: return "link_cut";
   }
   return "?";
 }
@@ -67,6 +73,7 @@ std::optional<Target> target_from_name(std::string_view name) {
   if (name == "RL") return Target::RL;
   if (name == "RR") return Target::RR;
   if (name == "CCU") return Target::CCU;
+  if (name == "CCU_STANDBY") return Target::CcuStandby;
   return std::nullopt;
 }
 
@@ -76,7 +83,8 @@ std::optional<std::size_t> corner_slot(Target t) {
     case Target::FR: return 1;
     case Target::RL: return 2;
     case Target::RR: return 3;
-    case Target::CCU: return std::nullopt;
+    case Target::CCU:
+    case Target::CcuStandby: return std::nullopt;
   }
   return std::nullopt;
 }
@@ -92,8 +100,10 @@ std::optional<Part> part_of(FaultType t) {
     case FaultType::TotalLoss:
     case FaultType::Seized: return Part::Actuator;
     case FaultType::Silence:
-    case FaultType::Delay: return Part::Network;
-    case FaultType::Kill: return Part::Process;
+    case FaultType::Delay:
+    case FaultType::LinkCut: return Part::Network;
+    case FaultType::Kill:
+    case FaultType::Hang: return Part::Process;
     case FaultType::Stuck: return std::nullopt;
   }
   return std::nullopt;

@@ -7,7 +7,7 @@ namespace {
 
 using config::Range;
 
-const std::vector<std::string> kTargets = {"FL", "FR", "RL", "RR", "CCU"};
+const std::vector<std::string> kTargets = {"FL", "FR", "RL", "RR", "CCU", "CCU_STANDBY"};
 const std::vector<std::string> kParts = {"load_cell", "resolver", "actuator", "network", "process"};
 
 Part part_from(const std::string& s) {
@@ -18,8 +18,11 @@ Part part_from(const std::string& s) {
   return Part::Process;
 }
 
-// The types each part accepts, in the order the docs list them.
-std::vector<std::string> types_of(Part p) {
+// The types each part accepts, in the order the docs list them. A CCU (primary or standby)
+// fails only as a process (kill, hang) or by its link (link_cut); a corner never hangs or has
+// its link cut (silence is the corner's link fault).
+std::vector<std::string> types_of(Part p, bool ccu) {
+  if (ccu) return p == Part::Network ? std::vector<std::string>{"link_cut"} : std::vector<std::string>{"kill", "hang"};
   switch (p) {
     case Part::LoadCell: return {"bias", "drift", "stuck", "noise_burst", "dropout"};
     case Part::Resolver: return {"offset", "stuck"};
@@ -42,6 +45,8 @@ FaultType type_from(const std::string& s) {
   if (s == "seized") return FaultType::Seized;
   if (s == "silence") return FaultType::Silence;
   if (s == "delay") return FaultType::Delay;
+  if (s == "hang") return FaultType::Hang;
+  if (s == "link_cut") return FaultType::LinkCut;
   return FaultType::Kill;
 }
 
@@ -57,10 +62,10 @@ FaultSpec read_one(config::Reader& r) {
   f.at_s = r.number("at_s", Range::non_negative());
   f.target = *target_from_name(r.choice("corner", kTargets));
   f.part = part_from(r.choice("part", kParts));
-  if (f.target == Target::CCU && f.part != Part::Process) {
-    r.fail("part", "the CCU can only fail as a process (part: process, type: kill)");
+  if (is_ccu(f.target) && f.part != Part::Process && f.part != Part::Network) {
+    r.fail("part", "a CCU can only fail as a process (part: process, type: kill or hang) or by its link (part: network, type: link_cut)");
   }
-  f.type = type_from(r.choice("type", types_of(f.part)));
+  f.type = type_from(r.choice("type", types_of(f.part, is_ccu(f.target))));
   switch (f.type) {
     case FaultType::Bias: f.bias_kN = nonzero(r, "bias_kN"); break;
     case FaultType::Drift: f.rate_kN_per_s = nonzero(r, "rate_kN_per_s"); break;
@@ -73,7 +78,15 @@ FaultSpec read_one(config::Reader& r) {
     case FaultType::Kill:
       if (r.has("restart_after_s")) f.restart_after_s = r.number("restart_after_s", Range::positive());
       if (r.has("duration_s")) r.fail("duration_s", "a kill lasts until the restart: use restart_after_s");
+      if (f.restart_after_s && is_ccu(f.target)) {
+        r.fail("restart_after_s", "a CCU is not restarted over DDS (a killed CCU stays dead; a hung one may resume: type hang, resume_after_s)");
+      }
       break;
+    case FaultType::Hang:
+      if (r.has("resume_after_s")) f.resume_after_s = r.number("resume_after_s", Range::positive());
+      if (r.has("duration_s")) r.fail("duration_s", "a hang lasts until it is resumed: use resume_after_s");
+      break;
+    case FaultType::LinkCut:
     case FaultType::Stuck:
     case FaultType::Dropout:
     case FaultType::TotalLoss:
@@ -81,7 +94,7 @@ FaultSpec read_one(config::Reader& r) {
     case FaultType::Silence: break;
   }
   if (f.type == FaultType::Silence && !r.has("duration_s")) r.fail("duration_s", "required key is missing (silence)");
-  if (f.type != FaultType::Kill && r.has("duration_s")) f.duration_s = r.number("duration_s", Range::positive());
+  if (f.type != FaultType::Kill && f.type != FaultType::Hang && r.has("duration_s")) f.duration_s = r.number("duration_s", Range::positive());
   r.finish();
   return f;
 }
@@ -90,7 +103,10 @@ void check_against(const scenario::Scenario& s, const FaultSchedule& faults, con
   for (std::size_t i = 0; i < faults.faults.size(); ++i) {
     const FaultSpec& f = faults.faults[i];
     const std::string at = "faults[" + std::to_string(i) + "]";
-    if (f.target != Target::CCU) {
+    if (f.target == Target::CcuStandby && !faults.standby) {
+      throw config::ConfigError(file, f.line, at + ".corner", "CCU_STANDBY needs a standby CCU (top-level standby: true)");
+    }
+    if (!is_ccu(f.target)) {
       const bool found = std::any_of(s.corners.begin(), s.corners.end(),
                                      [&](const scenario::CornerSpec& c) { return c.name == to_string(f.target); });
       if (!found) {
@@ -109,6 +125,7 @@ void check_against(const scenario::Scenario& s, const FaultSchedule& faults, con
 
 FaultSchedule read_fault_schedule(config::Reader& top) {
   FaultSchedule out;
+  out.standby = top.boolean_or("standby", false);
   if (!top.has("faults")) {
     (void)top.optional_map("faults");  // marks an explicit `faults:` (null) as known
     return out;

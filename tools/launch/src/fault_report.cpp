@@ -56,7 +56,7 @@ std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, co
   for (const Detection& d : detections) {
     const auto corner = faults::target_from_name(d.corner);
     const faults::Finding finding = faults::finding_from_name(d.finding);
-    if (!corner || *corner == faults::Target::CCU) throw std::runtime_error("detection of an unknown corner '" + d.corner + "'");
+    if (!corner || faults::is_ccu(*corner)) throw std::runtime_error("detection of an unknown corner '" + d.corner + "'");
     if (finding == faults::Finding::None) throw std::runtime_error("detection of an unknown finding '" + d.finding + "'");
     events.push_back({*corner, finding, d.onset_s, d.detected_s});
   }
@@ -64,7 +64,7 @@ std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, co
   for (const auto& [corner, t] : ccu_lost_s) lost.push_back(t);
   std::vector<FaultResult> out;
   for (const faults::FaultSpec& f : schedule.faults) {
-    FaultResult r = f.target == faults::Target::CCU ? faults::score_ccu_kill(f, lost) : faults::score_fault(f, events);
+    FaultResult r = faults::is_ccu(f.target) ? faults::score_ccu_kill(f, lost) : faults::score_fault(f, events);
     r.delivered_share = share(timeline, f.at_s, std::min(f.end_s(), run_end_s));
     out.push_back(r);
   }

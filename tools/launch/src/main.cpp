@@ -2,7 +2,11 @@
 //
 //   bbw_launch SCENARIO.yaml --out DIR [--mode lockstep|realtime] [--domain N]
 //              [--discovery-timeout S] [--friction-feedback on|off] [--no-report]
-//              [--secure [--keys DIR]]
+//              [--secure [--keys DIR]] [--standby]
+//
+// --standby (or the scenario's `standby: true`): a hot-standby CCU too (issue 16, docs/faults.md
+// "Hot-standby CCU"): bbw_ccu (primary) and bbw_ccu_standby both run warm, their commands under
+// DDS exclusive ownership; summary.json gets a `failover` object.
 //
 // --secure: DDS Security (docs/security.md) with the keys in DIR (default keys/ in the
 // repository, gitignored); when a file is missing scripts/bbw-keys.sh DIR creates it (output in
@@ -43,6 +47,7 @@
 #include "bbw/common/data_path.hpp"
 #include "bbw/dds/run_id.hpp"
 #include "bbw/dds/shm_cleanup.hpp"
+#include "bbw/runtime/failover_stats.hpp"
 #include "bbw/runtime/signals.hpp"
 #include "domain_claim.hpp"
 #include "options.hpp"
@@ -150,6 +155,7 @@ int main(int argc, char** argv) {
   plan.discovery_s = opt.discovery_s;
   plan.secure = opt.secure;
   plan.extra_processes = loaded->extra_processes;
+  plan.standby = loaded->schedule.standby;  // the scenario's standby: true, or --standby
 
   // A SIGINT/SIGTERM before the run's processes start (while the keys are created, say) still
   // leaves a partial summary marked interrupted, and the exit is 128 + the signal.
@@ -214,6 +220,15 @@ int main(int argc, char** argv) {
     run.report = opt.report;
     run.incarnations = result.incarnations;
     run.ended_by_injected_ccu_kill = result.ccu_killed;
+    run.standby = plan.standby;
+    if (plan.standby) {
+      // Summarise the CCU that ran on: the standby after the primary's failure.
+      const auto primary = bbw::runtime::load_ccu_failover(plan.out_dir + "/ccu_failover.stats");
+      const auto standby = bbw::runtime::load_ccu_failover(plan.out_dir + "/standby/ccu_failover.stats");
+      if (!primary.failure.empty() && (standby.failure.empty() || standby.failed_sim_s > primary.failed_sim_s)) {
+        run.ccu_dir = plan.out_dir + "/standby";
+      }
+    }
     run.launch_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     const auto t = bbw::launch::write_run_summary(run);
     if (!plan.extra_processes.empty()) bbw::launch::merge_vehicle_summary(plan.out_dir);

@@ -16,7 +16,7 @@ namespace bbw::launch {
 const char* const kUsage =
     "usage: bbw_launch SCENARIO.yaml --out DIR [--mode lockstep|realtime] [--domain N]\n"
     "                  [--discovery-timeout S] [--friction-feedback on|off] [--no-report]\n"
-    "                  [--secure [--keys DIR]] [--allow-large]\n";
+    "                  [--secure [--keys DIR]] [--allow-large] [--standby]\n";
 
 Options parse_options(int argc, char** argv) {
   Options o;
@@ -33,6 +33,7 @@ Options parse_options(int argc, char** argv) {
     else if (k == "--secure") o.secure = true;
     else if (k == "--keys") o.keys_dir = next();
     else if (k == "--allow-large") o.allow_large = true;
+    else if (k == "--standby") o.standby = true;
     else if (k == "-h" || k == "--help") {
       o.help = true;
       return o;
@@ -72,6 +73,18 @@ LoadedRun load_run(const Options& o) {
     r.schedule = std::move(fs.faults);
   }
   scenario::check_four_corner_run(r.scenario);
+  if (o.standby) r.schedule.standby = true;
+  for (const faults::FaultSpec& f : r.schedule.faults) {
+    if (f.type == faults::FaultType::LinkCut) {
+      throw std::invalid_argument(o.scenario_file + ": line " + std::to_string(f.line) +
+                                  ": a link_cut needs the processes in network namespaces; bbw_launch runs them on "
+                                  "this host (tests/system/test_failover_netns.cpp carries it out)");
+    }
+    if (f.type == faults::FaultType::Hang && !r.schedule.standby) {
+      throw std::invalid_argument(o.scenario_file + ": line " + std::to_string(f.line) +
+                                  ": a CCU hang needs a hot-standby CCU (standby: true or --standby)");
+    }
+  }
   if (!o.allow_large) scenario::check_run_size(r.scenario);
   for (const auto& a : faults::process_actions(r.schedule)) {
     if (a.target == faults::Target::CCU && a.kind == faults::ProcessAction::Kind::Restart) {

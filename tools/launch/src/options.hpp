@@ -22,6 +22,7 @@ struct Options {
   bool report = true;
   bool secure = false;
   bool allow_large = false;  // accept a run over the size limits (scenario/run_checks.hpp)
+  bool standby = false;      // --standby: a hot-standby CCU too (or the scenario's standby: true)
   std::string keys_dir;      // default: keys/ in bbw's data root (bbw/common/data_path.hpp)
   bool help = false;         // -h / --help: print kUsage, start nothing
 };

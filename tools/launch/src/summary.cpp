@@ -102,6 +102,7 @@ std::string tracking_not_scored_reason(const CornerSummary& s) {
 
 #include "bbw/common/json.hpp"
 #include "bbw/runtime/run_stats.hpp"
+#include "failover_summary.hpp"
 #include "fault_report.hpp"
 #include "partial_summary.hpp"
 #include "report.hpp"
@@ -122,7 +123,8 @@ std::string corner_stats_file(const std::string& out_dir, const std::string& cor
 RunTotals write_run_summary(const CompletedRun& run) {
   const scenario::Scenario& scenario = *run.scenario;
   const std::string& out_dir = run.out_dir;
-  const std::string ccu_stats_file = out_dir + "/ccu.stats";
+  const std::string& ccu_dir = run.ccu_dir.empty() ? out_dir : run.ccu_dir;
+  const std::string ccu_stats_file = ccu_dir + "/ccu.stats";
   const runtime::CcuRunStats ccu = runtime::load_ccu_stats(ccu_stats_file);
   auto incarnations_of = [&](const std::string& c) {
     const auto it = run.incarnations.find(c);
@@ -177,7 +179,7 @@ RunTotals write_run_summary(const CompletedRun& run) {
     };
     using CS = runtime::CornerRunStats;
     const runtime::CcuCornerStats& at_ccu = ccu.corner(c.name, ccu_stats_file);
-    const auto table = csv::read(out_dir + "/ccu_" + c.name + ".csv", ccu_log_columns());
+    const auto table = csv::read(ccu_dir + "/ccu_" + c.name + ".csv", ccu_log_columns());
     const auto m = summarize_corner(c.name, table);
     const long long pub = static_cast<long long>(corner_sum(&CS::samples_published));
     // Not receivable: still held back by an injected delay, or sent after the CCU died.
@@ -317,6 +319,9 @@ RunTotals write_run_summary(const CompletedRun& run) {
         .end_object();
   }
   j.end_array();
+  if (run.standby) {
+    write_failover(j, assess_failover(load_failover_input(scenario, out_dir, run.mode == "lockstep")));
+  }
   j.end_object();
   j.save(out_dir + "/summary.json");
   {

@@ -57,6 +57,11 @@ struct CompletedRun {
   std::map<std::string, unsigned> incarnations;  // corner -> processes started
   bool ended_by_injected_ccu_kill = false;
   double launch_wall_s = 0.0;
+  // A run with a hot-standby CCU (issue 16): summary.json gets a `failover` object
+  // (failover_summary.hpp), and the CCU logs and stats summarised are those of `ccu_dir` (the
+  // CCU that ran to the end: OUT, or OUT/standby after the primary failed; "" = out_dir).
+  bool standby = false;
+  std::string ccu_dir;
 };
 
 // "" for a corner's first process, ".<n>" for its incarnation n (file and process names).

@@ -129,7 +129,10 @@ Supervisor::Supervisor(RunPlan plan, const std::atomic<int>& stop_signal)
   // bbw_localhost_udp in config/dds/bbw_profiles.xml explains why).
   bool corner_restarts = false;
   for (const auto& a : actions_) corner_restarts |= a.kind == faults::ProcessAction::Kind::Restart;
-  if (corner_restarts) profile_args_ = {"--dds-participant-profile", "bbw_localhost_udp"};
+  // So does a run with a hot-standby CCU: a CCU stopped (hung) inside a shared-memory port
+  // operation holds that port's lock, and its peers' sends through it wait until it is continued
+  // (seen: two corners got no command for the whole 0.5 s hang; docs/faults.md).
+  if (corner_restarts || plan_.standby) profile_args_ = {"--dds-participant-profile", "bbw_localhost_udp"};
   bin_ = runtime::executable_dir();
   // Test hook: BBW_LAUNCH_CORNER_BIN replaces the corner executable (e.g. one that fails to
   // start), so the failure path is exercised with real processes.
@@ -157,6 +160,7 @@ void Supervisor::spawn_corner(const std::string& c, unsigned incarnation, double
     args.insert(args.end(), {"--peer-timeout", std::to_string(plan_.discovery_s + 10.0)});
   }
   if (plan_.secure) args.insert(args.end(), {"--secure", plan_.keys_dir});
+  if (plan_.standby) args.push_back("--standby");
   args.insert(args.end(), profile_args_.begin(), profile_args_.end());
   if (incarnation > 0) {
     args.insert(args.end(), {"--incarnation", std::to_string(incarnation), "--resume-at", std::to_string(resume_at_s)});
@@ -177,6 +181,19 @@ void Supervisor::start() {
     if (process_faults()) ccu_args.push_back("--process-faults");
     if (plan_.secure) ccu_args.insert(ccu_args.end(), {"--secure", plan_.keys_dir});
     ccu_args.insert(ccu_args.end(), profile_args_.begin(), profile_args_.end());
+    if (plan_.standby) {
+      // The hot-standby CCU: the same command line, its own role, logs and stats (issue 16).
+      std::vector<std::string> standby_args = ccu_args;
+      standby_args.insert(standby_args.end(), {"--standby", "--role", "standby"});
+      const std::string dir = plan_.out_dir + "/standby";
+      for (std::size_t i = 0; i + 1 < standby_args.size(); ++i) {
+        if (standby_args[i] == "--out") standby_args[i + 1] = dir;
+      }
+      std::filesystem::create_directories(dir);
+      ccu_args.insert(ccu_args.end(), {"--standby", "--role", "primary"});
+      children_.push_back(std::make_unique<Child>("bbw_ccu_standby", standby_args, plan_.out_dir + "/ccu_standby.out",
+                                                  plan_.out_dir + "/ccu_standby.err"));
+    }
     children_.push_back(std::make_unique<Child>("bbw_ccu", ccu_args, plan_.out_dir + "/ccu.out", plan_.out_dir + "/ccu.err"));
     for (const auto& c : plan_.scenario->corners) spawn_corner(c.name, 0, 0.0);
     // The further processes the scenario declares (a vehicle run: bbw_vehicle, bbw_pedal).
@@ -206,13 +223,26 @@ SupervisedRun Supervisor::run() {
                          (plan_.mode == "lockstep" ? 10.0 * scenario.duration_s + 60.0 : 1.5 * scenario.duration_s + 20.0);
   const auto deadline = wall0_ + seconds(bound_s);
   // Scheduled kills not yet carried out, per process name; restarts waiting for their time.
+  // A process that stops itself at a scheduled kill is SIGKILLed; at a scheduled hang (a CCU of
+  // a standby run) it is left stopped, and continued at its resume (if any).
+  auto key_of = [](faults::Target t) {
+    return t == faults::Target::CCU          ? std::string("bbw_ccu")
+           : t == faults::Target::CcuStandby ? std::string("bbw_ccu_standby")
+                                             : std::string(faults::to_string(t));
+  };
   std::map<std::string, std::vector<const faults::ProcessAction*>> kills_due;
   for (const auto& a : actions_) {
-    if (a.kind == faults::ProcessAction::Kind::Kill) {
-      kills_due[a.target == faults::Target::CCU ? std::string("bbw_ccu") : std::string(faults::to_string(a.target))]
-          .push_back(&a);
+    if (a.kind == faults::ProcessAction::Kind::Kill || a.kind == faults::ProcessAction::Kind::Hang) {
+      kills_due[key_of(a.target)].push_back(&a);
     }
   }
+  struct PendingResume {
+    Child* child;
+    Clock::time_point when;
+  };
+  std::vector<PendingResume> resumes;
+  std::set<Child*> hung;  // stopped by a scheduled hang, not (yet) continued
+  int ccus_down = 0;      // killed or hung for good
   struct PendingRestart {
     std::string corner;
     double resume_at_s;
@@ -236,21 +266,38 @@ SupervisedRun Supervisor::run() {
     // A process that froze itself at its scheduled kill: kill it now.
     for (auto& c : children_) {
       if (!c->take_stop()) continue;
-      const bool is_ccu = c->name() == "bbw_ccu";
-      auto& due = kills_due[is_ccu ? std::string("bbw_ccu") : corner_of(c->name())];
+      const bool is_ccu = c->name() == "bbw_ccu" || c->name() == "bbw_ccu_standby";
+      auto& due = kills_due[is_ccu ? c->name() : corner_of(c->name())];
       if (due.empty()) {
         c->send_signal(SIGCONT);  // stopped by someone else: not ours to kill
         continue;
       }
       const auto* kill = due.front();
       due.erase(due.begin());
+      if (kill->kind == faults::ProcessAction::Kind::Hang) {
+        hung.insert(c.get());
+        bool resumed = false;
+        for (const auto& a : actions_) {
+          if (a.kind == faults::ProcessAction::Kind::Resume && a.target == kill->target && a.at_s > kill->at_s) {
+            resumes.push_back({c.get(), Clock::now() + seconds(a.at_s - kill->at_s)});
+            resumed = true;
+            break;
+          }
+        }
+        if (!resumed) ++ccus_down;
+        std::cout << "bbw_launch: " << c->name() << " hangs as scheduled at " << kill->at_s << " s" << std::endl;
+        continue;
+      }
       c->send_signal(SIGKILL);
       c->wait_until(Clock::now() + 2000ms);
       killed_by_schedule.insert(c.get());
       std::cout << "bbw_launch: killed " << c->name() << " as scheduled at " << kill->at_s << " s" << std::endl;
       if (is_ccu) {
-        out.ccu_killed = true;
-        out.ccu_killed_at_s = kill->at_s;
+        // Without a standby a CCU kill ends the CCU's part in the run; with one, only when both are down.
+        if (!plan_.standby || ++ccus_down == 2) {
+          out.ccu_killed = true;
+          out.ccu_killed_at_s = kill->at_s;
+        }
         continue;
       }
       for (const auto& a : actions_) {
@@ -260,6 +307,16 @@ SupervisedRun Supervisor::run() {
           break;
         }
       }
+    }
+    for (auto it = resumes.begin(); it != resumes.end();) {
+      if (Clock::now() < it->when) {
+        ++it;
+        continue;
+      }
+      it->child->send_signal(SIGCONT);
+      hung.erase(it->child);
+      std::cout << "bbw_launch: continued " << it->child->name() << " as scheduled" << std::endl;
+      it = resumes.erase(it);
     }
     for (auto it = restarts.begin(); it != restarts.end();) {
       if (Clock::now() < it->when) {
@@ -282,7 +339,9 @@ SupervisedRun Supervisor::run() {
       const auto status = *c->status();
       if (!status.ok()) {
         const std::string name = c->name();
-        const std::string err_file = plan_.out_dir + (name == "bbw_ccu" ? "/ccu.err" : "/corner_" + name.substr(11) + ".err");
+        const std::string err_file = plan_.out_dir + (name == "bbw_ccu"           ? std::string("/ccu.err")
+                                                      : name == "bbw_ccu_standby" ? std::string("/ccu_standby.err")
+                                                                                  : "/corner_" + name.substr(11) + ".err");
         failure = name + " failed: " + reason(status);
         const std::string msg = last_line(err_file);
         if (!msg.empty()) failure += ": " + msg;
@@ -291,8 +350,18 @@ SupervisedRun Supervisor::run() {
     }
     if (!failure.empty()) break;
     bool running = false;
-    for (auto& c : children_) running = running || !c->poll();
-    if (!running && restarts.empty()) break;
+    for (auto& c : children_) running = running || (!c->poll() && hung.count(c.get()) == 0);
+    if (!running && restarts.empty() && resumes.empty()) {
+      // Only processes hung for good are left: the run is over; they end as scheduled.
+      for (Child* h : hung) {
+        h->send_signal(SIGKILL);
+        h->wait_until(Clock::now() + 2000ms);
+        killed_by_schedule.insert(h);
+        handled.insert(h);
+      }
+      if (plan_.standby && ccus_down == 2) out.ccu_killed = true;
+      break;
+    }
     if (Clock::now() >= deadline) {
       failure = "run exceeded its wall-time bound of " + std::to_string(static_cast<int>(bound_s)) + " s";
       break;

@@ -34,13 +34,16 @@ struct RunPlan {
   double discovery_s = 20.0;
   bool secure = false;
   std::vector<std::string> extra_processes;  // "vehicle", "pedal": bbw_vehicle, bbw_pedal (issue 15)
+  // A hot-standby CCU too (issue 16): bbw_ccu_standby (--role standby, logs and stats in
+  // OUT/standby, output OUT/ccu_standby.out/.err); every process runs with --standby.
+  bool standby = false;
 };
 
 struct SupervisedRun {
   std::string failure;                           // "" when every process ended as planned
   std::vector<ProcessEnd> processes;             // on a failure: how each ended
   std::map<std::string, unsigned> incarnations;  // corner -> processes started
-  bool ccu_killed = false;                       // by the scenario's schedule
+  bool ccu_killed = false;                       // by the scenario's schedule (with a standby: both CCUs down)
   double ccu_killed_at_s = -1.0;
   std::string unreached_kill;                    // a scheduled kill never reached (an error)
 };

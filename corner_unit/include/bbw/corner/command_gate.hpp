@@ -1,7 +1,8 @@
 // The corner's last line of defence against unsafe clamp-force commands, whatever their source
 // (issue 17): a command is refused unless it belongs to this run (its run id) and comes from the
 // CCU the corner matched at start: the first writer whose participant announced itself as this
-// run's CCU is pinned, and only it is accepted from then on. (Without DDS Security that
+// run's CCU is pinned, and only it is accepted from then on (with a hot-standby CCU: the first
+// two such writers, max_sources = 2). (Without DDS Security that
 // announcement is not authenticated: a process that copies it passes; with it, only the ccu
 // identity may write commands at all.) An accepted
 // force command is clamped to the caliper's rated range [0, max_force_kN] and its change to
@@ -21,6 +22,9 @@ namespace bbw::corner {
 struct CommandGateParams {
   double max_force_kN = 40.0;         // the caliper's rated clamp-force range [0, max]
   double max_rate_kN_per_s = 8000.0;  // the full range in one 5 ms CCU period
+  // Command writers that may be pinned: 1, or 2 in a run with a hot-standby CCU (issue 16: the
+  // primary's and the standby's; DDS exclusive ownership lets one through at a time).
+  int max_sources = 1;
   void validate() const;              // throws std::invalid_argument naming the field
 };
 
@@ -67,13 +71,15 @@ class CommandGate {
   GateResult check(const CommandSource& source, bool force_mode, double force_kN, double time_s);
 
   const CommandGateCounts& counts() const { return counts_; }
-  bool pinned() const { return pinned_.has_value(); }
+  bool pinned() const { return pinned_count_ == params_.max_sources; }
   const CommandGateParams& params() const { return params_; }
 
  private:
   std::uint64_t run_id_;
   CommandGateParams params_;
-  std::optional<std::array<std::uint8_t, 16>> pinned_;
+  std::array<std::array<std::uint8_t, 16>, 2> pinned_{};
+  int pinned_count_ = 0;
+  int last_source_ = -1;  // index into pinned_ of the last accepted command's writer
   std::optional<double> last_force_kN_;
   double last_time_s_ = 0.0;
   CommandGateCounts counts_;

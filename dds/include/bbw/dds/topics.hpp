@@ -1,6 +1,8 @@
 // Topic names and the QoS profile names each role uses, in one place.
 #pragma once
 
+#include <cstdint>
+
 namespace bbw::dds {
 
 inline constexpr const char* kMeasurementTopic = "bbw/MeasurementBlock";
@@ -29,6 +31,35 @@ constexpr ProfileNames profiles_for(bool lockstep) {
   }
   return {"measurement_writer_realtime", "measurement_reader_realtime", "command_writer_realtime",
           "command_reader_realtime"};
+}
+
+// With a hot-standby CCU (issue 16): the same, with the commands under EXCLUSIVE ownership and a
+// 10 ms deadline, and in lockstep measurement histories of 1024 blocks (the CCU that does not own
+// the corners' commands may lag them; config/dds/bbw_profiles.xml).
+constexpr ProfileNames profiles_for(bool lockstep, bool standby) {
+  ProfileNames p = profiles_for(lockstep);
+  if (standby && lockstep) {
+    p.measurement_writer = "measurement_writer_lockstep_standby";
+    p.measurement_reader = "measurement_reader_lockstep_standby";
+  }
+  if (standby) {
+    p.command_writer = lockstep ? "command_writer_lockstep_owned" : "command_writer_realtime_owned";
+    p.command_reader = lockstep ? "command_reader_lockstep_owned" : "command_reader_realtime_owned";
+  }
+  return p;
+}
+
+// Ownership strength of a CCU's command writers (issue 16, docs/faults.md "Hand-back"): the CCU
+// with fewer outages leads, the primary at equal counts. An outage: the CCU was stopped and
+// continued, or cut off from every corner; either may have moved the corners to the other CCU,
+// and its state is stale when it returns. Strength only falls, so a returning CCU never takes
+// the corners back from one that stayed. (A stall beyond the command deadline is no outage: the
+// corners go to the other CCU for the stall and come back, with the same commands.)
+inline constexpr std::uint32_t kStrengthBase = 1000000000;
+inline constexpr std::uint32_t kStrengthPerOutage = 1000;
+constexpr std::uint32_t ccu_strength(bool primary, std::uint32_t outages) {
+  const std::uint32_t n = outages < 999999 ? outages : 999999;
+  return kStrengthBase - n * kStrengthPerOutage + (primary ? 1u : 0u);
 }
 
 }  // namespace bbw::dds

@@ -12,6 +12,7 @@
 
 #include <bbw/idl/bbw_msgs.h>
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -41,6 +42,10 @@ struct CornerNodeOptions {
   // The run this corner belongs to (bbw_launch's run id; 0 in process): stamped on every block and
   // health message; commands and calibration states of another run are refused.
   std::uint64_t run_id = 0;
+  // A run with a hot-standby CCU (issue 16): the gate pins both CCUs' command writers, and in
+  // realtime a command from another writer than the last one (a takeover: DDS ownership chose
+  // it) is taken even if its period number is lower (the two CCUs' clocks start apart).
+  bool standby = false;
 };
 
 struct CornerStats {
@@ -50,6 +55,7 @@ struct CornerStats {
   std::uint64_t write_failures = 0;
   std::uint64_t commands_received = 0;
   std::uint64_t commands_applied = 0;
+  std::uint64_t commands_taken = 0;    // became the newest command (a hot-standby run's owner record)
   std::uint64_t command_seq_gaps = 0;
   std::uint64_t calibrations_applied = 0;
   std::uint64_t calibrations_rejected = 0;
@@ -157,6 +163,7 @@ class CornerNode {
   msg::ClampCommand latest_command_;
   bool have_command_ = false;
   std::optional<std::uint64_t> last_command_seq_;
+  std::array<std::uint8_t, 16> last_writer_{};  // of the newest command taken
   dds::CalibrationModel model_;
   dds::CalibrationModel candidate_;
   calibration::FrictionTracker friction_;  // element and play states of the CCU's friction model

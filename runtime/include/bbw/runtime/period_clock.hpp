@@ -107,12 +107,15 @@ class RealtimeClock final : public PeriodClock {
   double late_s_ = 0.0;
 };
 
-// The policy for `mode`: lockstep gives up after `lockstep_give_up_after` without a grant;
+// The policy for `mode`: lockstep gives up after `lockstep_give_up_after` without a grant and
+// calls the stall handler every `lockstep_stall_every`;
 // realtime paces on `period_s` (see RealtimeClock for `poll_while_waiting`).
-inline std::unique_ptr<PeriodClock> make_period_clock(ClockMode mode, dds::Events& events, double period_s,
-                                                      PeriodClock::Clock::duration lockstep_give_up_after,
-                                                      bool poll_while_waiting) {
-  if (mode == ClockMode::Lockstep) return std::make_unique<LockstepClock>(events, lockstep_give_up_after);
+inline std::unique_ptr<PeriodClock> make_period_clock(
+    ClockMode mode, dds::Events& events, double period_s, PeriodClock::Clock::duration lockstep_give_up_after,
+    bool poll_while_waiting, PeriodClock::Clock::duration lockstep_stall_every = std::chrono::milliseconds(200)) {
+  if (mode == ClockMode::Lockstep) {
+    return std::make_unique<LockstepClock>(events, lockstep_give_up_after, lockstep_stall_every);
+  }
   return std::make_unique<RealtimeClock>(events, period_s, poll_while_waiting);
 }
 

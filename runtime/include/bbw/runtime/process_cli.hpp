@@ -54,6 +54,9 @@ struct ProcessOptions {
   std::chrono::milliseconds peer_timeout{10000};
   // Process faults of the schedule are carried out (bbw_launch runs the process and kills it).
   bool process_faults = false;
+  // The run has a hot-standby CCU (--standby, issue 16): commands under DDS exclusive ownership
+  // (profiles *_owned), and the corners accept the two CCUs' command writers.
+  bool standby = false;
 };
 
 // The flags both processes take. take() consumes one of them from the cursor; finish() checks

@@ -18,8 +18,10 @@ class SecurityError : public std::runtime_error {
 
 // Identities `./bbw keys` issues, one per process.
 inline constexpr const char* kCcuIdentity = "ccu";
-inline const std::vector<std::string>& identities() {  // ccu, fl, fr, rl, rr
-  static const std::vector<std::string> ids{"ccu", "fl", "fr", "rl", "rr"};
+// The hot-standby CCU (issue 16): its own identity, with the CCU's permissions.
+inline constexpr const char* kCcuStandbyIdentity = "ccu_standby";
+inline const std::vector<std::string>& identities() {  // ccu, ccu_standby, fl, fr, rl, rr
+  static const std::vector<std::string> ids{"ccu", "ccu_standby", "fl", "fr", "rl", "rr"};
   return ids;
 }
 

@@ -35,9 +35,11 @@ class LinkFaults {
   std::vector<FaultSpec> faults_;
 };
 
-// What the launcher must do and when, in time order (kills and restarts of every target).
+// What the launcher must do and when, in time order (kills and restarts of every target; hangs
+// of a CCU and their resumption). A link cut is no process action: it needs network namespaces
+// (tests/system/test_failover_netns.cpp carries it out).
 struct ProcessAction {
-  enum class Kind { Kill, Restart };
+  enum class Kind { Kill, Restart, Hang, Resume };
   double at_s = 0.0;
   Target target = Target::FL;
   Kind kind = Kind::Kill;

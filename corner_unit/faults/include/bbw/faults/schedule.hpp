@@ -10,7 +10,9 @@
 
 namespace bbw::faults {
 
-enum class Target { FL, FR, RL, RR, CCU };
+// CCU is the (primary) CCU; CCU_STANDBY the hot-standby CCU of a run with `standby: true`
+// (docs/faults.md, "Hot-standby CCU").
+enum class Target { FL, FR, RL, RR, CCU, CcuStandby };
 enum class Part { LoadCell, Resolver, Actuator, Network, Process };
 enum class FaultType {
   Bias,        // load cell: + bias_kN
@@ -25,6 +27,8 @@ enum class FaultType {
   Silence,     // network: the corner's messages stop (for duration_s, required)
   Delay,       // network: the corner's messages arrive delay_ms late
   Kill,        // process: the corner (or CCU) process is killed; optionally restarted
+  Hang,        // process (a CCU): the process stops (SIGSTOP); continued after resume_after_s if given
+  LinkCut,     // network (a CCU): its network link goes down for duration_s (network namespaces only)
 };
 
 struct FaultSpec {
@@ -41,6 +45,7 @@ struct FaultSpec {
   double torque_loss_percent = 0.0;
   double delay_ms = 0.0;
   std::optional<double> restart_after_s;  // process kill
+  std::optional<double> resume_after_s;   // process hang (absent: hung to the end)
   int line = 0;                           // where it was read from (0 when built in code)
 
   // Active in [at_s, at_s + duration_s); a kill is active until the restart (if any).
@@ -50,6 +55,9 @@ struct FaultSpec {
 
 struct FaultSchedule {
   std::vector<FaultSpec> faults;  // in file order
+  // Top-level `standby: true`: the run has a hot-standby CCU (docs/faults.md). Read with the
+  // schedule because it changes which process faults make sense (CCU_STANDBY, hang, link_cut).
+  bool standby = false;
 
   // The faults of one target, in file order (allocates; call at set-up).
   std::vector<FaultSpec> for_target(Target t) const;
@@ -61,6 +69,8 @@ const char* to_string(Part p);
 const char* to_string(FaultType t);
 // "FL" -> Target::FL ...; nullopt for anything else.
 std::optional<Target> target_from_name(std::string_view name);
+// CCU or CCU_STANDBY.
+inline bool is_ccu(Target t) { return t == Target::CCU || t == Target::CcuStandby; }
 // The corner index of FL/FR/RL/RR in that order (the CCU has none).
 std::optional<std::size_t> corner_slot(Target t);
 // Which part a type belongs to (Stuck belongs to both sensors: nullopt).
