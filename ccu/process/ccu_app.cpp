@@ -417,13 +417,20 @@ int CcuApp::run(std::string& error) {
         drain_qos_events(t_end, true);
         return node_.period_complete(k);
       };
+      last_wake_ = Clock::now();
       const runtime::PeriodStart begun = clock->begin(k, pred, [&] {
-        // A standby run: no block from any corner for kCutOff_s of wall time while waiting is a
-        // cut link (the corners go on under the other CCU). Who leads never changes a lockstep
-        // log (both CCUs compute the same commands), so a slow machine mistaken for a cut costs
+        // A standby run: no block from any corner for kCutOff_s of wall time while waiting, while
+        // this CCU itself woke on time (every kStandbyResend), is a cut link (the corners go on
+        // under the other CCU). A CCU starved of the CPU wakes late and sees the same silence:
+        // that is no cut (as in realtime, `ran_on_time`). Who leads never changes a lockstep log
+        // (both CCUs compute the same commands), so a slow machine mistaken for a cut costs
         // nothing but the order of the two CCUs.
-        if (options_.standby && !cut_off_ && last_block_at_ != Clock::time_point{} &&
-            std::chrono::duration<double>(Clock::now() - last_block_at_).count() > kCutOff_s) {
+        const auto now = Clock::now();
+        if (now - last_wake_ > 2.5 * kStandbyResend) last_stall_at_ = now;
+        last_wake_ = now;
+        const bool ran_on_time = std::chrono::duration<double>(now - last_stall_at_).count() > kCutOff_s;
+        if (options_.standby && !cut_off_ && ran_on_time && last_block_at_ != Clock::time_point{} &&
+            std::chrono::duration<double>(now - last_block_at_).count() > kCutOff_s) {
           demote(t_k, "cut off from every corner");
           cut_off_ = true;
         }

@@ -124,7 +124,8 @@ class CcuApp {
   std::chrono::steady_clock::time_point last_send_{};     // realtime, standby run: the last command send
   std::chrono::steady_clock::time_point last_block_at_{}; // ... and the last block from any corner
   bool cut_off_ = false;                                  // no block from any corner for kCutOff_s
-  std::chrono::steady_clock::time_point last_stall_at_{}; // realtime: its own last stall
+  std::chrono::steady_clock::time_point last_stall_at_{}; // its own last stall (realtime: a late send; lockstep: a late wake)
+  std::chrono::steady_clock::time_point last_wake_{};     // lockstep, standby run: the last wake while waiting
   std::chrono::steady_clock::time_point quiet_until_{};   // back from a long outage: no command until then
   std::uint32_t reannouncements_ = 0;                     // strength announced again after a cut
   // Lockstep with a standby: blocks of later periods than this CCU's, per corner (FIFO ring).
