@@ -365,6 +365,17 @@ std::vector<double> Reader::numbers(const std::string& key, const Range& range) 
   return out;
 }
 
+std::vector<std::string> Reader::strings(const std::string& key) {
+  const YAML::Node n = required(key);
+  if (!n.IsSequence() || n.size() == 0) fail(key, std::string("must be a non-empty list of strings, got ") + type_name(n));
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    if (!n[i].IsScalar()) fail(key, "entry " + std::to_string(i) + " must be a string, got " + type_name(n[i]));
+    out.push_back(n[i].as<std::string>());
+  }
+  return out;
+}
+
 Reader Reader::map(const std::string& key) {
   const YAML::Node n = required(key);
   if (!n.IsMap()) fail(key, std::string("must be a mapping, got ") + type_name(n));
