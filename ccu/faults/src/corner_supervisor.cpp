@@ -107,6 +107,7 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
     if (e.fit_accepted && monitor_.ok(Part::LoadCell) && monitor_.ok(Part::Resolver)) {
       last_good_.push(r.time_s, *calibrator_);
       monitor_.set_curve_range(fed_min_rev_, fed_max_rev_);  // the fits had data here
+      monitor_.set_fit_rms(calibrator_->stats().last_fit_rms_kN);  // its model uncertainty
     }
     if (monitor_.ok(Part::Resolver)) last_friction_kN_ = e.friction_kN;
   }

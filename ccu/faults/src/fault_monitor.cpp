@@ -25,6 +25,16 @@ void MonitorParams::validate() const {
   positive("residual_persist_s", residual_persist_s);
   positive("residual_reference_s", residual_reference_s);
   positive("residual_change_threshold_kN", residual_change_threshold_kN);
+  positive("residual_sigma_factor", residual_sigma_factor);
+  positive("residual_stats_s", residual_stats_s);
+  require(std::isfinite(residual_speed_kN_per_rev_per_s) && residual_speed_kN_per_rev_per_s >= 0.0,
+          "residual_speed_kN_per_rev_per_s", residual_speed_kN_per_rev_per_s, "must be >= 0");
+  require(std::isfinite(eol_friction_half_width_kN) && eol_friction_half_width_kN >= 0.0, "eol_friction_half_width_kN",
+          eol_friction_half_width_kN, "must be >= 0");
+  positive("eol_band_kN", eol_band_kN);
+  require(std::isfinite(eol_relative) && eol_relative >= 0.0, "eol_relative", eol_relative, "must be >= 0");
+  require(std::isfinite(eol_speed_kN_per_rev_per_s) && eol_speed_kN_per_rev_per_s >= 0.0, "eol_speed_kN_per_rev_per_s",
+          eol_speed_kN_per_rev_per_s, "must be >= 0");
   require(std::isfinite(curve_min_rev), "curve_min_rev", curve_min_rev, "must be finite");
   require(std::isfinite(curve_max_rev) && curve_max_rev > curve_min_rev, "curve_max_rev", curve_max_rev,
           "must be finite and > curve_min_rev");
@@ -98,7 +108,7 @@ Part part_of(Finding f) {
 }
 
 FaultMonitor::FaultMonitor(const MonitorParams& params, Target corner)
-    : p_((params.validate(), params)), corner_(corner), residual_(params.curve_min_rev, params.curve_max_rev) {
+    : p_((params.validate(), params)), corner_(corner), residual_(params) {
   if (!corner_slot(corner)) throw std::invalid_argument("FaultMonitor: monitors a corner, not the CCU");
 }
 
