@@ -77,7 +77,10 @@ bool right_finding(const FaultSpec& f, Finding d) {
     // A loss of 75 % or more leaves the motor below the lost threshold (a quarter of its torque).
     case FaultType::TorqueLoss:
       return d == Finding::ActuatorTorqueLoss || (d == Finding::ActuatorLost && f.torque_loss_percent >= 75.0);
-    case FaultType::TotalLoss: return d == Finding::ActuatorLost || d == Finding::ActuatorTracking;
+    // Without motor torque a brake whose screw the clamp load cannot back-drive holds its force:
+    // not releasing is that loss seen from outside (the same reaction: out of use).
+    case FaultType::TotalLoss:
+      return d == Finding::ActuatorLost || d == Finding::ActuatorTracking || d == Finding::ActuatorNotReleasing;
     case FaultType::Seized:
       return d == Finding::ActuatorLost || d == Finding::ActuatorNotReleasing || d == Finding::ActuatorTracking;
     case FaultType::Silence:

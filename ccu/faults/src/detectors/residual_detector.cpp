@@ -17,7 +17,9 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
                               const JumpDetector& jump) {
   const double t = r.time_s;
   residual_kN_ = e.force_kN - e.curve_force_kN;
-  noise.update(residual_kN_, t, p, a);
+  // Below the trusted range (released, no clamp load) the key friction snaps back and forth with
+  // small motions by up to its full width within milliseconds: that is not sensor noise.
+  if (r.position_rev >= trusted_min_rev_ || !eol_) noise.update(residual_kN_, t, p, a);
   // With an end-of-line curve, a calibrated corner's residual is its estimate (load cell minus
   // the calibrator's friction) against that curve, everywhere above the trusted minimum: the
   // fitted cubic is an approximation fitted to wherever the cycles went, the end-of-line curve
@@ -46,12 +48,18 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   } else {
     if (eol_) {
       const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
-      residual_kN_ = e.force_kN - eol_->force_kN(r.position_rev, temperature_C, 0.0);
+      // The calibrator's friction, within what the caliper's key friction can hold (a fit that
+      // explains more than the end-of-line width as friction is wrong, not the load cell).
+      const double hw = p.eol_friction_half_width_kN;
+      const double friction_kN = std::clamp(e.friction_kN, -hw, hw);
+      residual_kN_ = e.force_kN + e.friction_kN - friction_kN - eol_->force_kN(r.position_rev, temperature_C, 0.0);
     }
     if (!std::isfinite(ms_residual_kN2_)) {
-      // Start from the fixed thresholds (their sigma), learn the corner's own from there.
-      ms_residual_kN2_ = std::pow(p.residual_threshold_kN / p.residual_sigma_factor, 2);
-      ms_change_kN2_ = std::pow(p.residual_change_threshold_kN / p.residual_sigma_factor, 2);
+      // The first fit's friction model may be poor: start from the end-of-line band (or, without
+      // an end-of-line curve, from the fixed thresholds) and learn the corner's own from there.
+      const double start_kN = eol_ ? p.eol_friction_half_width_kN + p.eol_band_kN : p.residual_threshold_kN;
+      ms_residual_kN2_ = std::pow(start_kN / p.residual_sigma_factor, 2);
+      ms_change_kN2_ = std::pow(std::max(p.residual_change_threshold_kN, eol_ ? start_kN : 0.0) / p.residual_sigma_factor, 2);
       stats_time_s_ = t;
     }
     thr = std::max(p.residual_threshold_kN, p.residual_sigma_factor * std::max(fit_rms_kN_, std::sqrt(ms_residual_kN2_)));

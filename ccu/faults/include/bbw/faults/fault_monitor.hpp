@@ -46,7 +46,7 @@ struct MonitorParams {
   // frozen while a fault is suspected) beyond residual_change_threshold_kN is also a
   // disagreement (once calibrated): it catches a step whose sign the standing calibration error
   // partly cancels, or that the local loop's reaction partly hides.
-  double residual_reference_s = 0.5;
+  double residual_reference_s = 0.1;
   double residual_change_threshold_kN = 0.45;
   // Once calibrated, both thresholds scale with the corner's own model uncertainty (never below
   // the fixed values above): residual_sigma_factor times the larger of the residual RMS of its
@@ -54,7 +54,7 @@ struct MonitorParams {
   // over residual_stats_s, updated only while nothing is suspected. docs/faults.md, "Thresholds".
   double residual_sigma_factor = 4.0;
   double residual_stats_s = 5.0;
-  double residual_speed_kN_per_rev_per_s = 0.1;  // added to both, times |speed|
+  double residual_speed_kN_per_rev_per_s = 0.3;  // added to both, times |speed|
   // The end-of-line curve: the caliper's own clamp curve with its temperature coefficients, as
   // measured at the end of its production line (CcuCore sets it from the scenario's plant, as it
   // sets the actuator model; absent: the rule is off). Before the first accepted fit, and
@@ -66,7 +66,7 @@ struct MonitorParams {
   std::optional<plant::ClampCurveParams> eol_curve;
   double eol_friction_half_width_kN = 1.0;
   double eol_band_kN = 0.5;
-  double eol_relative = 0.08;
+  double eol_relative = 0.03;
   double eol_speed_kN_per_rev_per_s = 0.3;
   // Where the curve is trusted: the calibrator's range (CornerSupervisor copies x_min_rev and
   // x_max_rev of the calibrator config here). Outside it the cubic is an extrapolation.
