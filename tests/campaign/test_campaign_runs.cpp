@@ -6,7 +6,9 @@
 
 #include <chrono>
 #include <filesystem>
+#include <cstdlib>
 #include <fstream>
+#include <set>
 #include <string>
 
 #include "system_test_support.hpp"
@@ -119,5 +121,42 @@ TEST(CampaignSystem, DdsAndMemoryScoreARunAlike) {
     }
     EXPECT_EQ(a["false_alarms"].size(), b["false_alarms"].size()) << run;
   }
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+// Two Linux network namespaces as two GNU parallel hosts (scripts/netns-ssh.sh as its ssh): every
+// run goes over Fast DDS inside one of them, and both are used. Root only (else skipped); the
+// namespaces are deleted at the end, also on failure.
+TEST(CampaignSystem, TwoNetworkNamespacesServeAsTwoHosts) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root (ip netns add)";
+  const std::string a = "bbwcmp" + std::to_string(::getpid()) + "_a", b = "bbwcmp" + std::to_string(::getpid()) + "_b";
+  struct Namespaces {
+    std::vector<std::string> names;
+    ~Namespaces() {
+      for (const auto& n : names) std::system(("ip netns del " + n + " 2>/dev/null").c_str());
+    }
+  } guard{{a, b}};
+  for (const auto& n : {a, b}) {
+    if (std::system(("ip netns add " + n + " && ip -n " + n + " link set lo up").c_str()) != 0) {
+      GTEST_SKIP() << "ip netns add " << n << " failed";
+    }
+  }
+  const std::string dir = bbw::system_test::scratch("campaign", "netns");
+  const std::string spec = small_spec(dir, 4);
+  const auto r = campaign(dir, "hosts",
+                          {spec, "--out", dir + "/c", "--jobs", "2", "--ssh", src("scripts/netns-ssh.sh"), "--sshlogin",
+                           "1/" + a, "--sshlogin", "1/" + b},
+                          200s);
+  ASSERT_TRUE(r.status.ok()) << r.err;
+  std::set<std::string> hosts;
+  for (int i = 0; i < 4; ++i) {
+    char run[16];
+    std::snprintf(run, sizeof run, "%05d", i);
+    const YAML::Node res = YAML::LoadFile(dir + "/c/runs/" + run + "/result.json");
+    EXPECT_TRUE(res["ok"].as<bool>()) << res["error"].as<std::string>();
+    EXPECT_EQ(res["transport"].as<std::string>(), "dds");
+    hosts.insert(res["host"].as<std::string>());
+  }
+  EXPECT_EQ(hosts, (std::set<std::string>{a, b}));
   if (!HasFailure()) fs::remove_all(dir);
 }

@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -191,6 +192,8 @@ int cmd_run(const std::string& dir, int index, const std::string& transport, boo
   r.profile = plan["profile"].as<std::string>();
   r.duration_s = fsn.scenario.duration_s;
   r.transport = transport;
+  const char* login = std::getenv("PARALLEL_SSHLOGIN");  // set by GNU parallel on the host it runs on
+  r.host = login != nullptr && *login != '\0' ? login : ":";
   std::vector<std::string> kinds, onsets;
   for (const auto& f : plan["faults"]) {
     kinds.push_back(f["kind"].as<std::string>());

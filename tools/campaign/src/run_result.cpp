@@ -81,6 +81,7 @@ void save_result(const RunResult& r, const std::string& file) {
       .value("fault_free", r.fault_free)
       .value("profile", r.profile)
       .value("transport", r.transport)
+      .value("host", r.host)
       .value("duration_s", r.duration_s)
       .value("wall_s", r.wall_s)
       .value("ok", r.ok)
@@ -126,6 +127,7 @@ RunResult load_result(const std::string& file) {
     r.fault_free = n["fault_free"].as<bool>();
     r.profile = n["profile"].as<std::string>();
     r.transport = n["transport"].as<std::string>();
+    r.host = n["host"].as<std::string>();
     r.duration_s = n["duration_s"].as<double>();
     r.wall_s = n["wall_s"].as<double>();
     r.ok = n["ok"].as<bool>();

@@ -40,6 +40,7 @@ struct RunResult {
   bool fault_free = true;
   std::string profile;
   std::string transport;
+  std::string host;           // the GNU parallel sshlogin that ran it (":" this host)
   double duration_s = 0.0;
   double wall_s = 0.0;
   bool ok = true;             // the run itself completed (else `error`)
