@@ -27,6 +27,8 @@ void MonitorParams::validate() const {
   positive("residual_change_threshold_kN", residual_change_threshold_kN);
   positive("residual_sigma_factor", residual_sigma_factor);
   positive("residual_stats_s", residual_stats_s);
+  require(std::isfinite(residual_speed_free_rev_per_s) && residual_speed_free_rev_per_s >= 0.0,
+          "residual_speed_free_rev_per_s", residual_speed_free_rev_per_s, "must be >= 0");
   require(std::isfinite(residual_speed_kN_per_rev_per_s) && residual_speed_kN_per_rev_per_s >= 0.0,
           "residual_speed_kN_per_rev_per_s", residual_speed_kN_per_rev_per_s, "must be >= 0");
   require(std::isfinite(eol_friction_half_width_kN) && eol_friction_half_width_kN >= 0.0, "eol_friction_half_width_kN",
@@ -41,6 +43,7 @@ void MonitorParams::validate() const {
   positive("jump_threshold_rev", jump_threshold_rev);
   positive("jump_confirm_s", jump_confirm_s);
   positive("jump_window_s", jump_window_s);
+  positive("jump_max_gap_s", jump_max_gap_s);
   require(stuck_samples >= 2, "stuck_samples", stuck_samples, "must be >= 2");
   positive("stuck_min_travel_rev", stuck_min_travel_rev);
   positive("stuck_min_force_change_kN", stuck_min_force_change_kN);

@@ -30,6 +30,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.residual_sigma_factor = res.number("sigma_factor", pos);
   p.residual_stats_s = res.number("stats_s", pos);
   p.residual_speed_kN_per_rev_per_s = res.number("speed_kN_per_rev_per_s", config::Range::non_negative());
+  p.residual_speed_free_rev_per_s = res.number("speed_free_rev_per_s", config::Range::non_negative());
   {
     auto eol = res.map("end_of_line");
     p.eol_band_kN = eol.number("band_kN", pos);
@@ -46,6 +47,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.jump_threshold_rev = j.number("threshold_rev", pos);
   p.jump_confirm_s = j.number("confirm_s", pos);
   p.jump_window_s = j.number("window_s", pos);
+  p.jump_max_gap_s = j.number("max_gap_s", pos);
   j.finish();
 
   auto s = r.map("stuck");

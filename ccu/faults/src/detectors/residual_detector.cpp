@@ -65,7 +65,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     thr = std::max(p.residual_threshold_kN, p.residual_sigma_factor * std::max(fit_rms_kN_, std::sqrt(ms_residual_kN2_)));
     change_thr = std::max(p.residual_change_threshold_kN, p.residual_sigma_factor * std::max(fit_rms_kN_, std::sqrt(ms_change_kN2_)));
     // Unmodelled speed effects (viscous friction, sensor delay) grow with speed.
-    const double speed_kN = p.residual_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s);
+    // Beyond the speeds a force loop corrects at (its reaction to a step must stay visible).
+    const double speed_kN = p.residual_speed_kN_per_rev_per_s * std::max(0.0, std::abs(r.speed_rev_per_s) - p.residual_speed_free_rev_per_s);
     thr += speed_kN;
     change_thr += speed_kN;
     if (eol_mode_) have_reference_ = false;

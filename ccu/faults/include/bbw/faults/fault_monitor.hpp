@@ -54,7 +54,8 @@ struct MonitorParams {
   // over residual_stats_s, updated only while nothing is suspected. docs/faults.md, "Thresholds".
   double residual_sigma_factor = 4.0;
   double residual_stats_s = 5.0;
-  double residual_speed_kN_per_rev_per_s = 0.3;  // added to both, times |speed|
+  double residual_speed_kN_per_rev_per_s = 0.3;  // added to both, times |speed| beyond:
+  double residual_speed_free_rev_per_s = 3.0;
   // The end-of-line curve: the caliper's own clamp curve with its temperature coefficients, as
   // measured at the end of its production line (CcuCore sets it from the scenario's plant, as it
   // sets the actuator model; absent: the rule is off). Before the first accepted fit, and
@@ -82,6 +83,7 @@ struct MonitorParams {
   double jump_threshold_rev = 0.01;
   double jump_confirm_s = 0.01;     // a jump not undone within this is an offset
   double jump_window_s = 0.05;      // a jump this recent explains a residual as the resolver's
+  double jump_max_gap_s = 0.003;    // no prediction across a longer gap between usable samples
 
   // Stuck channels: exactly repeated readings while the other channel moves.
   int stuck_samples = 20;
