@@ -326,3 +326,22 @@ TEST(ClosedLoop, ARestartedCornerRejoinsWithItsLastGoodCurveAndNoSampleTwice) {
   EXPECT_TRUE(back);
   EXPECT_GT(recovery_time_s(r, 0.9, kFaultAt + 0.6, kStopEnd, 160.0), 0.0);
 }
+
+// Issue 14: after a correctly diagnosed resolver offset the estimate (load cell minus a friction
+// followed from the load cell's own motion, never below 0) stays within 1 kN of the true force;
+// with the friction frozen at the fault it was 2.1 kN off (a release, and a released brake).
+TEST(ClosedLoopIssue14, AfterAResolverOffsetTheEstimateDoesNotUseTheResolver) {
+  const auto r = run_closed_loop(load("config/scenarios/faults/resolver_offset.yaml"), default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  ASSERT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct);
+  const std::size_t i = *corner_slot(r.outcomes[0].fault.target);
+  double worst = 0.0;
+  for (const auto& p : r.periods) {
+    if (p.time_s >= r.outcomes[0].detected_s + 0.05 && std::isfinite(p.estimate_kN[i])) {
+      worst = std::max(worst, std::abs(p.estimate_kN[i] - p.true_kN[i]));
+    }
+  }
+  std::printf("resolver offset: worst |estimate - true| after the diagnosis %.3f kN\n", worst);
+  EXPECT_LT(worst, 1.0);
+}
+

@@ -6,6 +6,12 @@
 namespace bbw::faults {
 namespace {
 
+// The resolver-free estimate's play: the share of a load change the key friction takes until it
+// saturates (element stiffness against the curve's slope), and the load's low-pass per sample
+// (10 ms at 1 kHz: the noise must not walk the friction).
+constexpr double kFrictionShare = 0.5;
+constexpr double kLoadFilterGain = 0.1;
+
 MonitorParams with_curve_range(MonitorParams p, const calibration::CalibratorConfig& c) {
   p.curve_min_rev = c.x_min_rev;
   p.curve_max_rev = c.x_max_rev;
@@ -72,6 +78,9 @@ void CornerSupervisor::react_to_new_findings() {
   if (!monitor_.ok(Part::Resolver) && !resolver_reacted_) {
     resolver_reacted_ = true;
     frozen_friction_kN_ = last_friction_kN_;
+    load_friction_kN_ = std::clamp(last_friction_kN_, -monitor_.params().eol_friction_half_width_kN,
+                                   monitor_.params().eol_friction_half_width_kN);
+    load_filtered_kN_ = std::numeric_limits<double>::quiet_NaN();
   }
 }
 
@@ -131,7 +140,18 @@ void CornerSupervisor::refresh_view(const CornerReading* r, const SampleCheck* c
       view_.force_estimate_kN = std::max(0.0, curve.force_kN(r->position_rev));
       view_.source = EstimateSource::Curve;
     } else if (!res_ok && lc_ok && lc_present) {
-      view_.force_estimate_kN = r->load_cell_kN - frozen_friction_kN_;
+      // Without the resolver: the load cell minus the friction frozen at the fault (within what
+      // the caliper's key friction can hold), never below 0 (a released brake's load cell reads
+      // its friction: -1.1 kN gave an estimate of -2.1 kN, issue 14).
+      const double hw = monitor_.params().eol_friction_half_width_kN;
+      if (std::isfinite(load_filtered_kN_)) {
+        const double prev = load_filtered_kN_;
+        load_filtered_kN_ += (r->load_cell_kN - load_filtered_kN_) * kLoadFilterGain;
+        load_friction_kN_ = std::clamp(load_friction_kN_ + kFrictionShare * (load_filtered_kN_ - prev), -hw, hw);
+      } else {
+        load_filtered_kN_ = r->load_cell_kN;
+      }
+      view_.force_estimate_kN = std::max(0.0, r->load_cell_kN - load_friction_kN_);
       view_.source = EstimateSource::LoadCell;
     } else {
       view_.force_estimate_kN = std::numeric_limits<double>::quiet_NaN();
