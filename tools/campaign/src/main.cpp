@@ -396,7 +396,7 @@ int cmd_report(const std::string& dir) {
     }
   }
   std::ostringstream gp;
-  gp << "set terminal pngcairo size 900,480\nset datafile missing '-'\nset grid y\n"
+  gp << "set terminal pngcairo size 900,480 noenhanced\nset datafile missing '-'\nset grid y\nset key below\n"
      << "set output " << plot::quote(pd + "/coverage.png") << "\n"
      << "set title 'Coverage per fault type (95 % Wilson interval)'\nset ylabel 'detected, %'\nset yrange [0:105]\n"
      << "set xtics rotate by -30\nset style fill solid 0.5\nset boxwidth 0.6\n"
@@ -406,8 +406,9 @@ int cmd_report(const std::string& dir) {
      << "plot " << plot::quote(pd + "/latency.dat") << " using 1:3:xtic(2) with points pt 7 title 'p50', '' using 1:4 with points pt 5 title 'p95', '' using 1:5 with points pt 9 title 'max'\n"
      << "unset logscale y\nunset xtics\nset xtics\n"
      << "set output " << plot::quote(pd + "/harm.png") << "\n"
-     << "set title 'Harm while undetected (each injected fault)'\nset xlabel 'max |true force - command|, kN'\nset ylabel 'max |estimate - true force|, kN'\n"
-     << "plot " << plot::quote(pd + "/harm.dat") << " using ($3==1?$1:1/0):2 with points pt 7 ps 0.6 title 'detected', '' using ($3==0?$1:1/0):2 with points pt 2 ps 1.2 lc rgb 'red' title 'missed'\n";
+     << "set title 'Harm while undetected (each injected fault; log scales, floored at 0.01 kN)'\nset xlabel 'max |true force - command|, kN'\nset ylabel 'max |estimate - true force|, kN'\n"
+     << "set logscale xy\n"
+     << "plot " << plot::quote(pd + "/harm.dat") << " using ($3==1?($1>0.01?$1:0.01):1/0):($2>0.01?$2:0.01) with points pt 7 ps 0.6 title 'detected', '' using ($3==0?($1>0.01?$1:0.01):1/0):($2>0.01?$2:0.01) with points pt 2 ps 1.2 lc rgb 'red' title 'missed'\n";
   bool plots = true;
   try {
     plot::run_gnuplot(gp.str(), pd + "/campaign.gp");
