@@ -14,6 +14,7 @@
 #include "bbw/plant/params_yaml.hpp"
 #include "bbw/scenario/load.hpp"
 #include "bbw/scenario/population.hpp"
+#include "spec.hpp"  // tools/campaign: the campaign spec
 
 namespace fs = std::filesystem;
 
@@ -29,6 +30,7 @@ TEST(EveryConfig, EachYamlFileLoadsWithItsFoldersLoader) {
       {"analysis", [](const std::string& f) { bbw::analyze::load_options_file(f); }},
       {"faults", [](const std::string& f) { bbw::faults::load_monitor_params(f); }},
       {"population", [](const std::string& f) { bbw::scenario::load_population_spec(f); }},
+      {"campaigns", [](const std::string& f) { bbw::campaign::load_campaign_spec(f); }},
   };
   int loaded = 0;
   for (const auto& entry : fs::recursive_directory_iterator(root)) {
