@@ -23,9 +23,10 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // With an end-of-line curve, a calibrated corner's residual is its estimate (load cell minus
   // the calibrator's friction) against that curve, everywhere above the trusted minimum: the
   // fitted cubic is an approximation fitted to wherever the cycles went, the end-of-line curve
-  // holds over the whole stroke. Without one, the fitted cubic where the fits had data.
+  // holds over the whole stroke. Without one, the calibrator's curve where the fits had data
+  // (before the first fit: its initial curve against the uncalibrated threshold).
   const bool above_min = r.position_rev >= trusted_min_rev_;
-  const bool fitted_here = e.calibrated && (eol_ ? above_min : r.position_rev >= curve_min_rev_ && r.position_rev <= curve_max_rev_);
+  const bool fitted_here = eol_ ? e.calibrated && above_min : r.position_rev >= curve_min_rev_ && r.position_rev <= curve_max_rev_;
   const bool eol_here = !fitted_here && eol_ && above_min;
   if (!fitted_here && !eol_here) {
     suspect_ = false;  // no trusted curve here
@@ -45,6 +46,9 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
           p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s);
     if (!eol_mode_) have_reference_ = false;
     eol_mode_ = true;
+  } else if (!e.calibrated) {
+    thr = p.uncalibrated_residual_threshold_kN;  // no end-of-line curve: the initial curve
+    eol_mode_ = false;
   } else {
     if (eol_) {
       const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
@@ -88,7 +92,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   const bool change_rule = !eol_here && e.calibrated;
   const bool over = p.residual_findings &&
                     (std::abs(residual_kN_) > thr || (change_rule && std::abs(change_kN_) > change_thr));
-  if (!over && !eol_here && std::isfinite(change_kN_)) {
+  if (!over && !eol_here && e.calibrated && std::isfinite(ms_residual_kN2_) && std::isfinite(change_kN_)) {
     // Healthy: the corner's own residual statistics follow (never while suspected).
     const double w = -std::expm1(-std::max(0.0, t - stats_time_s_) / p.residual_stats_s);
     ms_residual_kN2_ += (residual_kN_ * residual_kN_ - ms_residual_kN2_) * w;
