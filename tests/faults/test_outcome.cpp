@@ -89,6 +89,8 @@ TEST(FaultScorer, NothingDetectedAndProcessKills) {
   const FaultOutcome o = score_fault(kill, {{Target::RR, Finding::LinkLost, 3.0, 3.02}, {Target::RR, Finding::ProcessLost, 3.0, 5.0}});
   EXPECT_TRUE(o.correct);
   EXPECT_NEAR(o.latency_ms, 20.0, 1e-9);
+  EXPECT_EQ(o.diagnosis, Finding::ProcessLost) << "the process, once named, refines the lost link";
+  EXPECT_DOUBLE_EQ(o.diagnosis_s, 5.0);
   EXPECT_FALSE(score_fault(kill, {{Target::RR, Finding::LinkLost, 3.0, 3.5}}).detected) << "outside the 100 ms window";
 }
 

@@ -124,21 +124,28 @@ RunScore score_run(const std::vector<FaultSpec>& faults, const std::vector<Detec
         first_right = &d;
       }
     }
-    const DetectionEvent* shown = first_right != nullptr ? first_right : first_any;
-    if (shown != nullptr) {
-      // The diagnosis is that finding's final form: a later right finding of the same part
-      // refines it (actuator_lost -> actuator_not_releasing once a release is commanded).
-      const DetectionEvent* last = shown;
+    if (first_right != nullptr) {
+      // The diagnosis is the last right finding for the fault (actuator_lost -> not releasing
+      // once a release is commanded; link_lost -> process_lost when the process is named), made
+      // when its part was first rightly found.
+      const DetectionEvent* last = first_right;
       for (const DetectionEvent& d : detections) {
-        if (d.corner == f.target && d.detected_s >= last->detected_s && part_of(d.finding) == part_of(shown->finding) &&
-            (first_right == nullptr || right_finding(f, d.finding))) {
-          last = &d;
-        }
+        if (explains(f, d) && d.detected_s >= last->detected_s) last = &d;
+      }
+      const DetectionEvent* made = last;
+      for (const DetectionEvent& d : detections) {
+        if (explains(f, d) && part_of(d.finding) == part_of(last->finding) && d.detected_s < made->detected_s) made = &d;
       }
       r.diagnosis = last->finding;
-      r.diagnosis_s = shown->detected_s;
-      r.diagnosis_latency_ms = 1e3 * (shown->detected_s - f.at_s);
+      r.diagnosis_s = made->detected_s;
+      r.diagnosis_latency_ms = 1e3 * (made->detected_s - f.at_s);
       r.reaction = reaction_to(last->finding);
+    } else if (first_any != nullptr) {
+      // Shown, not counted: what the corner raised instead (or too late).
+      r.diagnosis = first_any->finding;
+      r.diagnosis_s = first_any->detected_s;
+      r.diagnosis_latency_ms = 1e3 * (first_any->detected_s - f.at_s);
+      r.reaction = reaction_to(first_any->finding);
     }
     if (first_right != nullptr) {
       r.detected = true;
