@@ -69,6 +69,20 @@ void CornerSupervisor::rejoin() {
   ++restarts_;
 }
 
+void CornerSupervisor::resume_after_dropout() {
+  // The load cell is back: the calibrator it stopped resumes from the newest good curve (its
+  // cycle state did not survive the gap), and the load cell is used again.
+  load_cell_reacted_ = false;
+  const CalibrationSnapshot& good = last_good_.newest();
+  calibration::CalibratorConfig cfg = config_;
+  cfg.initial_curve = good.curve;
+  calibrator_.emplace(cfg);
+  calibrator_->set_friction_stiffness(good.stiffness_kN_per_rev);
+  fusion_.reset();
+  last_fed_time_s_ = std::numeric_limits<double>::quiet_NaN();
+  ++restarts_;
+}
+
 void CornerSupervisor::react_to_new_findings() {
   if (!monitor_.ok(Part::LoadCell) && !load_cell_reacted_) {
     // Back to the newest curve fitted before the fault began; the load cell is no longer used.
@@ -111,6 +125,7 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
   refresh_view(check.usable() ? &r : nullptr, &check, fed);
   monitor_.update(r, check, fed, view_.force_estimate_kN, arrival_s);
   if (monitor_.take_rejoin()) rejoin();
+  if (monitor_.take_load_cell_cleared()) resume_after_dropout();
   react_to_new_findings();
   if (fed != nullptr && e.valid) {
     if (e.fit_accepted && monitor_.ok(Part::LoadCell) && monitor_.ok(Part::Resolver)) {

@@ -54,6 +54,7 @@ void MonitorParams::validate() const {
   require(noise_min_fraction > 0.0 && noise_min_fraction <= 1.0, "noise_min_fraction", noise_min_fraction,
           "must be in (0, 1]");
   require(dropout_samples >= 1, "dropout_samples", dropout_samples, "must be >= 1");
+  require(dropout_clear_samples >= 1, "dropout_clear_samples", dropout_clear_samples, "must be >= 1");
   positive("torque_per_A_Nm", torque_per_A_Nm);
   positive("Nm_per_kN", Nm_per_kN);
   require(torque_fraction_threshold > 0.0 && torque_fraction_threshold < 1.0, "torque_fraction_threshold",

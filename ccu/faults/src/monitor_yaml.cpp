@@ -65,6 +65,7 @@ MonitorParams read_monitor_params(Reader& r) {
 
   auto d = r.map("dropout");
   p.dropout_samples = static_cast<int>(d.integer("samples", 1, 100000));
+  p.dropout_clear_samples = static_cast<int>(d.integer("clear_samples", 1, 100000));
   d.finish();
 
   auto t = r.map("torque");

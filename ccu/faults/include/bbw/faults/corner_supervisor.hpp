@@ -67,6 +67,7 @@ class CornerSupervisor {
   Target corner() const { return corner_; }
 
  private:
+  void resume_after_dropout();
   void react_to_new_findings();
   void rejoin();
   void refresh_view(const CornerReading* r, const SampleCheck* c, const calibration::Estimate* e);

@@ -99,6 +99,9 @@ struct MonitorParams {
 
   // Dropout: consecutive samples without a load-cell value.
   int dropout_samples = 5;
+  // A dropout ends: after this many consecutive samples with a value again the load-cell finding
+  // (a dropout only) clears, and the calibrator it stopped resumes from the last good curve.
+  int dropout_clear_samples = 200;
 
   // Actuator torque balance: the torque the axial load and the acceleration need,
   // load * Nm_per_kN + J 2 pi a, against the torque the measured current should make,
@@ -149,6 +152,8 @@ class FaultMonitor {
   // Samples arrived again after a link or process loss; cleared by take_rejoin().
   bool rejoined() const { return link_.rejoined(); }
   bool take_rejoin() { return link_.take_rejoin(); }
+  // A dropout finding cleared (its values are back); true once per clearing.
+  bool take_load_cell_cleared() { return dropout_.take_cleared(); }
   // Whether the last loss was the process (liveliness), so its sequence starts again.
   bool process_was_lost() const { return link_.process_was_lost(); }
   // Delivered / expected torque, from the last torque check (1 until one ran).
