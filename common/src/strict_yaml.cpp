@@ -227,17 +227,6 @@ std::string Reader::child_path(const std::string& key) const {
   return path_.empty() ? key : path_ + "." + key;
 }
 
-std::vector<std::string> Reader::strings(const std::string& key) {
-  const YAML::Node n = required(key);
-  if (!n.IsSequence()) fail(key, std::string("must be a list of strings, got ") + type_name(n));
-  std::vector<std::string> out;
-  for (const auto& e : n) {
-    if (!e.IsScalar()) fail(key, "every entry must be a string");
-    out.push_back(e.Scalar());
-  }
-  return out;
-}
-
 bool Reader::has(const std::string& key) const {
   const YAML::Node n = node_[key];
   return n.IsDefined() && !n.IsNull();
@@ -372,6 +361,17 @@ std::vector<double> Reader::numbers(const std::string& key, const Range& range) 
                         range.describe() + ", got '" + item.Scalar() + "'");
     }
     out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<std::string> Reader::strings(const std::string& key) {
+  const YAML::Node n = required(key);
+  if (!n.IsSequence() || n.size() == 0) fail(key, std::string("must be a non-empty list of strings, got ") + type_name(n));
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    if (!n[i].IsScalar()) fail(key, "entry " + std::to_string(i) + " must be a string, got " + type_name(n[i]));
+    out.push_back(n[i].as<std::string>());
   }
   return out;
 }

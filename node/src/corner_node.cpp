@@ -63,6 +63,12 @@ CornerNode::CornerNode(const scenario::Scenario& scenario, const CornerNodeOptio
       link_(options.schedule, target_of(options.corner)),
       watchdog_(options.watchdog),
       resume_step_(static_cast<std::uint64_t>(std::ceil(options.resume_at_s / scenario.ccu_period_s - 1e-9))) {
+  for (const faults::ProcessAction& a : faults::process_actions(options.schedule)) {
+    // The CCU freezes at the first period start at or after its kill (ccu_app.cpp).
+    if (a.target == faults::Target::CCU && a.kind == faults::ProcessAction::Kind::Kill && !ccu_kill_at_s_) {
+      ccu_kill_at_s_ = std::ceil(a.at_s / scenario.ccu_period_s - 1e-9) * scenario.ccu_period_s;
+    }
+  }
   block_.corner_id(my_id_);
   block_.run_id(options.run_id);
   block_.incarnation(options.incarnation);
@@ -242,8 +248,13 @@ void CornerNode::block_sent(bool ok) {
   }
   ++stats_.blocks_published;
   stats_.samples_published += block_.samples().size();
-  if (ccu_lost_ || last_mode_ == faults::WatchdogMode::Holding || last_mode_ == faults::WatchdogMode::Default) {
-    stats_.samples_without_ccu += block_.samples().size();
+  // Not receivable: samples after the period the scheduled CCU kill froze the CCU at.
+  // Not the watchdog's view: a CCU that is only late (a loaded machine, realtime) still receives
+  // every sample, and counting those made summary.json's samples_lost negative (issue 14).
+  if (ccu_kill_at_s_) {
+    for (const auto& m : block_.samples()) {
+      if (m.time_s() > *ccu_kill_at_s_ + 1e-9) ++stats_.samples_without_ccu;
+    }
   }
 }
 

@@ -106,3 +106,13 @@ TEST(StrictYaml, ResolveRelative) {
   EXPECT_EQ(bbw::config::resolve_relative("a.yaml", "p.yaml"), "p.yaml");
   EXPECT_EQ(bbw::config::resolve_relative("x/a.yaml", "/abs/p.yaml"), "/abs/p.yaml");
 }
+
+TEST(StrictYaml, StringListsAreReadAndEmptyOrNestedOnesRefused) {
+  auto r = Reader::from_string("a: [x, y]\nb: []\nc: [x, [y]]\nd: 3\n", "s.yaml");
+  EXPECT_EQ(r.strings("a"), (std::vector<std::string>{"x", "y"}));
+  EXPECT_NE(std::string(expect_error([&] { r.strings("b"); }).what()).find("s.yaml:2: key 'b'"), std::string::npos);
+  EXPECT_NE(expect_error([&] { r.strings("c"); }).rule().find("entry 1 must be a string"), std::string::npos);
+  EXPECT_NE(expect_error([&] { r.strings("d"); }).rule().find("non-empty list of strings"), std::string::npos);
+  EXPECT_NE(expect_error([&] { r.strings("missing"); }).rule().find("required"), std::string::npos);
+  EXPECT_NO_THROW(r.finish());  // every key was read
+}

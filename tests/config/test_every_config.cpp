@@ -17,6 +17,7 @@
 #include "bbw/brake/brake_yaml.hpp"
 #include "bbw/vehicle/params_yaml.hpp"
 #include "bbw/vehicle_run/vehicle_scenario.hpp"
+#include "spec.hpp"  // tools/campaign: the campaign spec
 
 namespace fs = std::filesystem;
 
@@ -39,6 +40,7 @@ TEST(EveryConfig, EachYamlFileLoadsWithItsFoldersLoader) {
        }},
       {"scenarios/vehicle", [](const std::string& f) { bbw::vehicle_run::load_vehicle_scenario(f); }},
       {"scenarios/vehicle/corners", [](const std::string& f) { bbw::faults::load_fault_scenario(f); }},
+      {"campaigns", [](const std::string& f) { bbw::campaign::load_campaign_spec(f); }},
   };
   int loaded = 0;
   for (const auto& entry : fs::recursive_directory_iterator(root)) {

@@ -15,42 +15,89 @@ FaultSpec fault(Target t, Part p, FaultType type, double at_s) {
   return f;
 }
 
-TEST(FaultScorer, PrefersTheInjectedPartAndTimesTheFirstDetection) {
+TEST(FaultScorer, OnlyTheRightFindingOnItsCornerWithinTheWindowDetects) {
   const FaultSpec f = fault(Target::FR, Part::LoadCell, FaultType::Bias, 2.0);
   const std::vector<DetectionEvent> d{
-      {Target::FR, Finding::ResolverOffset, 1.0, 1.5},     // before the injection: ignored
-      {Target::FL, Finding::LoadCellOffset, 2.0, 2.01},    // another corner: ignored
-      {Target::FR, Finding::ActuatorTracking, 2.0, 2.02},  // first on the corner, wrong part
-      {Target::FR, Finding::LoadCellOffset, 2.0, 2.05}};   // the right part, later
-  const FaultOutcome o = score_fault(f, d);
+      {Target::FR, Finding::ResolverOffset, 1.0, 1.5},     // before the injection: a false alarm
+      {Target::FL, Finding::LoadCellOffset, 2.0, 2.01},    // another corner: a false alarm
+      {Target::FR, Finding::ActuatorTracking, 2.0, 2.02},  // first on the corner, wrong part: a false alarm
+      {Target::FR, Finding::LoadCellOffset, 2.0, 2.05}};   // the right finding, in the window
+  const RunScore s = score_run({f}, d);
+  ASSERT_EQ(s.outcomes.size(), 1u);
+  const FaultOutcome& o = s.outcomes[0];
   EXPECT_TRUE(o.detected);
-  EXPECT_DOUBLE_EQ(o.detected_s, 2.02);
-  EXPECT_NEAR(o.latency_ms, 20.0, 1e-9);
-  EXPECT_DOUBLE_EQ(o.diagnosis_s, 2.05);
-  EXPECT_NEAR(o.diagnosis_latency_ms, 50.0, 1e-9);
+  EXPECT_DOUBLE_EQ(o.detected_s, 2.05);
+  EXPECT_NEAR(o.latency_ms, 50.0, 1e-9);
   EXPECT_EQ(o.diagnosis, Finding::LoadCellOffset);
-  EXPECT_TRUE(o.correct);
+  EXPECT_FALSE(o.correct) << "a wrong finding on the corner within the window";
+  ASSERT_EQ(s.false_alarms.size(), 3u);
+  EXPECT_EQ(s.false_alarms[2].finding, Finding::ActuatorTracking);
   EXPECT_EQ(diagnosis_name(o), "load_cell_offset");
   EXPECT_STREQ(o.reaction, reaction_to(Finding::LoadCellOffset));
+  // Alone, the right finding is detected and correct, and explains itself.
+  const RunScore clean = score_run({f}, {d[3]});
+  EXPECT_TRUE(clean.outcomes[0].detected && clean.outcomes[0].correct);
+  EXPECT_TRUE(clean.false_alarms.empty());
 }
 
-TEST(FaultScorer, AWrongPartIsDetectedButNotCorrectAndAnUpgradeRefinesTheDiagnosis) {
-  const FaultSpec f = fault(Target::RL, Part::LoadCell, FaultType::Stuck, 1.0);
-  const FaultOutcome o = score_fault(f, {{Target::RL, Finding::ActuatorLost, 1.0, 1.2},
-                                         {Target::RL, Finding::ActuatorNotReleasing, 1.0, 1.6}});
-  EXPECT_TRUE(o.detected);
-  EXPECT_FALSE(o.correct);
+TEST(FaultScorer, ALateRightFindingIsAMissButNoFalseAlarm) {
+  const FaultSpec f = fault(Target::FL, Part::LoadCell, FaultType::Bias, 1.0);
+  ASSERT_DOUBLE_EQ(detection_window_s(f), 0.5);
+  const RunScore s = score_run({f}, {{Target::FL, Finding::LoadCellOffset, 1.0, 4.2}});
+  EXPECT_FALSE(s.outcomes[0].detected);
+  EXPECT_FALSE(s.outcomes[0].correct);
+  EXPECT_EQ(s.outcomes[0].diagnosis, Finding::LoadCellOffset);  // shown, not counted
+  EXPECT_TRUE(s.false_alarms.empty());
+  // A drift's window is the time to reach the bias limit plus the bias window.
+  FaultSpec drift = fault(Target::FL, Part::LoadCell, FaultType::Drift, 1.0);
+  drift.rate_kN_per_s = -0.25;
+  EXPECT_DOUBLE_EQ(detection_window_s(drift), 1.0 / 0.25 + 0.5);
+}
+
+TEST(FaultScorer, AWrongPartIsNotADetectionAndAnUpgradeRefinesTheDiagnosis) {
+  const FaultSpec stuck = fault(Target::RL, Part::LoadCell, FaultType::Stuck, 1.0);
+  const RunScore wrong = score_run({stuck}, {{Target::RL, Finding::ActuatorLost, 1.0, 1.2}});
+  EXPECT_FALSE(wrong.outcomes[0].detected);
+  EXPECT_EQ(wrong.false_alarms.size(), 1u);
+  const FaultSpec seized = fault(Target::RL, Part::Actuator, FaultType::Seized, 1.0);
+  const FaultOutcome o = score_fault(seized, {{Target::RL, Finding::ActuatorLost, 1.0, 1.02},
+                                              {Target::RL, Finding::ActuatorNotReleasing, 1.0, 1.6}});
+  EXPECT_TRUE(o.detected && o.correct);
   EXPECT_EQ(o.diagnosis, Finding::ActuatorNotReleasing);
-  EXPECT_DOUBLE_EQ(o.diagnosis_s, 1.2);
+  EXPECT_DOUBLE_EQ(o.diagnosis_s, 1.02);
+}
+
+TEST(FaultScorer, TwoFaultsOnOneCornerEachNeedTheirOwnFinding) {
+  FaultSpec bias = fault(Target::FR, Part::LoadCell, FaultType::Bias, 2.0);
+  FaultSpec offset = fault(Target::FR, Part::Resolver, FaultType::Offset, 2.0);
+  const RunScore only_resolver = score_run({bias, offset}, {{Target::FR, Finding::ResolverOffset, 2.0, 2.01}});
+  EXPECT_FALSE(only_resolver.outcomes[0].detected);
+  EXPECT_TRUE(only_resolver.outcomes[1].detected && only_resolver.outcomes[1].correct);
+  EXPECT_TRUE(only_resolver.false_alarms.empty());
+  const RunScore both = score_run({bias, offset}, {{Target::FR, Finding::ResolverOffset, 2.0, 2.01},
+                                                   {Target::FR, Finding::LoadCellOffset, 2.0, 2.03}});
+  EXPECT_TRUE(both.outcomes[0].correct && both.outcomes[1].correct);
 }
 
 TEST(FaultScorer, NothingDetectedAndProcessKills) {
   EXPECT_FALSE(score_fault(fault(Target::FL, Part::Resolver, FaultType::Offset, 1.0), {}).detected);
   EXPECT_EQ(diagnosis_name(score_fault(fault(Target::FL, Part::Resolver, FaultType::Offset, 1.0), {})), "none");
-  // A kill names the process; a lost link is a detection, not the right diagnosis.
-  const FaultSpec kill = fault(Target::RR, Part::LoadCell, FaultType::Kill, 3.0);
-  EXPECT_FALSE(score_fault(kill, {{Target::RR, Finding::LinkLost, 3.0, 3.1}}).correct);
-  EXPECT_TRUE(score_fault(kill, {{Target::RR, Finding::LinkLost, 3.0, 3.1}, {Target::RR, Finding::ProcessLost, 3.0, 3.5}}).correct);
+  // A kill: a lost link within the window detects it (the same reaction; the lease names the
+  // process later), the process finding refines it.
+  const FaultSpec kill = fault(Target::RR, Part::Process, FaultType::Kill, 3.0);
+  EXPECT_TRUE(score_fault(kill, {{Target::RR, Finding::LinkLost, 3.0, 3.02}}).correct);
+  const FaultOutcome o = score_fault(kill, {{Target::RR, Finding::LinkLost, 3.0, 3.02}, {Target::RR, Finding::ProcessLost, 3.0, 5.0}});
+  EXPECT_TRUE(o.correct);
+  EXPECT_NEAR(o.latency_ms, 20.0, 1e-9);
+  EXPECT_EQ(o.diagnosis, Finding::ProcessLost) << "the process, once named, refines the lost link";
+  EXPECT_DOUBLE_EQ(o.diagnosis_s, 5.0);
+  EXPECT_FALSE(score_fault(kill, {{Target::RR, Finding::LinkLost, 3.0, 3.5}}).detected) << "outside the 100 ms window";
+}
+
+TEST(FaultScorer, AFaultFreeRunsFindingsAreAllFalseAlarms) {
+  const RunScore s = score_run({}, {{Target::RL, Finding::LoadCellOffset, 3.0, 3.02}, {Target::FL, Finding::LinkLost, 4.0, 4.01}});
+  EXPECT_TRUE(s.outcomes.empty());
+  EXPECT_EQ(s.false_alarms.size(), 2u);
 }
 
 TEST(FaultScorer, ACcuKillIsScoredByTheCornersWatchdogs) {

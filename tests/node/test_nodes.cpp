@@ -85,6 +85,37 @@ TEST(CornerNode, TakesOnlyItsOwnCommandsAndSimulatesAGrantedPeriod) {
   EXPECT_EQ(fl.stats().command_seq_gaps, 4u);
 }
 
+// Issue 14: samples_lost came out negative in a realtime run under load: the corner counted as
+// "without CCU" every sample it sent while its watchdog held (late commands), though the CCU was
+// alive and received them. Only samples after a scheduled CCU kill are not receivable now.
+TEST(CornerNode, CountsSamplesWithoutTheCcuOnlyAfterAScheduledCcuKill) {
+  const auto fs = load("config/scenarios/vehicle_stop.yaml");
+  auto run = [&](const faults::FaultSchedule& schedule) {
+    CornerNodeOptions o = options_for(fs.scenario, 0);
+    o.schedule = schedule;
+    CornerNode fl(fs.scenario, o);
+    msg::ClampCommand c;
+    c.corner_id(static_cast<std::uint8_t>(fl.corner()));
+    c.step(0);
+    c.valid(true);
+    fl.on_command(c, kCcu, 0.0);  // the only command: the watchdog holds, then goes to its default
+    fl.start();
+    for (std::uint64_t k = 0; k < 200; ++k) {  // 1 s
+      if (fl.simulate_period(k) != nullptr) fl.block_sent(true);
+    }
+    EXPECT_GT(fl.stats().ccu_lost_s, 0.0) << "the watchdog found the CCU lost";
+    return fl.stats();
+  };
+  EXPECT_EQ(run({}).samples_without_ccu, 0u);
+  faults::FaultSpec kill;
+  kill.target = faults::Target::CCU;
+  kill.part = faults::Part::Process;
+  kill.type = faults::FaultType::Kill;
+  kill.at_s = 0.5012;  // the CCU freezes at the period starting at 0.505 s
+  const CornerStats s = run(faults::FaultSchedule{{kill}});
+  EXPECT_EQ(s.samples_without_ccu, static_cast<std::uint64_t>(std::llround((1.0 - 0.505) / fs.scenario.plant_dt_s)));
+}
+
 TEST(CcuNode, DropsForeignAndFloodingBlocksAndCountsThem) {
   const auto fs = load("config/scenarios/vehicle_stop.yaml");
   CcuNode ccu(fs.scenario, test::robust_config(), true);

@@ -3,7 +3,7 @@
 // process and one thread, in lockstep: the same node cores and protocol as `./bbw run` over
 // Fast DDS, so it writes the same logs (ccu_<corner>.csv, ccu_periods.csv,
 // corner_<corner>_periods.csv; test InProcessSystem.LogsEqualTheDdsRun), and a summary.json
-// with the run's real-time factor. Process faults (kill, restart) need real processes: refused.
+// with the run's real-time factor, and detections.csv (the fault monitor's detections). Process faults (kill, restart) need real processes: refused.
 //
 // Exit: 0 done, 1 runtime error, 2 bad arguments or config.
 #include <chrono>
@@ -109,6 +109,18 @@ int main(int argc, char** argv) {
     }
     std::fprintf(f, "\n  },\n  \"detections\": %zu\n}\n", run.ccu().detections().size());
     if (std::fclose(f) != 0) throw std::runtime_error(summary + ": write failed");
+    // The fault monitor's detections (as ccu.stats holds them after a DDS run), for scorers.
+    {
+      const std::string file = out_dir + "/detections.csv";
+      std::FILE* d = std::fopen(file.c_str(), "w");
+      if (d == nullptr) throw std::runtime_error(file + ": cannot write");
+      std::fprintf(d, "corner,finding,onset_s,detected_s\n");
+      for (const auto& r : run.ccu().detections()) {
+        std::fprintf(d, "%s,%s,%.6f,%.6f\n", bbw::faults::to_string(static_cast<bbw::faults::Target>(r.slot)),
+                     bbw::faults::to_string(r.finding), r.onset_s, r.detected_s);
+      }
+      if (std::fclose(d) != 0) throw std::runtime_error(file + ": write failed");
+    }
     std::cout << "bbw_inproc: " << fs.scenario.name << ", " << run.periods_done() << " periods, " << sim_s << " s simulated in "
               << wall_s << " s (" << (wall_s > 0.0 ? sim_s / wall_s : 0.0) << "x real time); logs in " << out_dir << "\n";
   } catch (const std::invalid_argument& e) {

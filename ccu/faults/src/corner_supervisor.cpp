@@ -6,6 +6,12 @@
 namespace bbw::faults {
 namespace {
 
+// The resolver-free estimate's play: the share of a load change the key friction takes until it
+// saturates (element stiffness against the curve's slope), and the load's low-pass per sample
+// (10 ms at 1 kHz: the noise must not walk the friction).
+constexpr double kFrictionShare = 0.5;
+constexpr double kLoadFilterGain = 0.1;
+
 MonitorParams with_curve_range(MonitorParams p, const calibration::CalibratorConfig& c) {
   p.curve_min_rev = c.x_min_rev;
   p.curve_max_rev = c.x_max_rev;
@@ -63,6 +69,20 @@ void CornerSupervisor::rejoin() {
   ++restarts_;
 }
 
+void CornerSupervisor::resume_after_dropout() {
+  // The load cell is back: the calibrator it stopped resumes from the newest good curve (its
+  // cycle state did not survive the gap), and the load cell is used again.
+  load_cell_reacted_ = false;
+  const CalibrationSnapshot& good = last_good_.newest();
+  calibration::CalibratorConfig cfg = config_;
+  cfg.initial_curve = good.curve;
+  calibrator_.emplace(cfg);
+  calibrator_->set_friction_stiffness(good.stiffness_kN_per_rev);
+  fusion_.reset();
+  last_fed_time_s_ = std::numeric_limits<double>::quiet_NaN();
+  ++restarts_;
+}
+
 void CornerSupervisor::react_to_new_findings() {
   if (!monitor_.ok(Part::LoadCell) && !load_cell_reacted_) {
     // Back to the newest curve fitted before the fault began; the load cell is no longer used.
@@ -72,6 +92,9 @@ void CornerSupervisor::react_to_new_findings() {
   if (!monitor_.ok(Part::Resolver) && !resolver_reacted_) {
     resolver_reacted_ = true;
     frozen_friction_kN_ = last_friction_kN_;
+    load_friction_kN_ = std::clamp(last_friction_kN_, -monitor_.params().eol_friction_half_width_kN,
+                                   monitor_.params().eol_friction_half_width_kN);
+    load_filtered_kN_ = std::numeric_limits<double>::quiet_NaN();
   }
 }
 
@@ -102,11 +125,13 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
   refresh_view(check.usable() ? &r : nullptr, &check, fed);
   monitor_.update(r, check, fed, view_.force_estimate_kN, arrival_s);
   if (monitor_.take_rejoin()) rejoin();
+  if (monitor_.take_load_cell_cleared()) resume_after_dropout();
   react_to_new_findings();
   if (fed != nullptr && e.valid) {
     if (e.fit_accepted && monitor_.ok(Part::LoadCell) && monitor_.ok(Part::Resolver)) {
       last_good_.push(r.time_s, *calibrator_);
       monitor_.set_curve_range(fed_min_rev_, fed_max_rev_);  // the fits had data here
+      monitor_.set_fit_rms(calibrator_->stats().last_fit_rms_kN);  // its model uncertainty
     }
     if (monitor_.ok(Part::Resolver)) last_friction_kN_ = e.friction_kN;
   }
@@ -130,7 +155,18 @@ void CornerSupervisor::refresh_view(const CornerReading* r, const SampleCheck* c
       view_.force_estimate_kN = std::max(0.0, curve.force_kN(r->position_rev));
       view_.source = EstimateSource::Curve;
     } else if (!res_ok && lc_ok && lc_present) {
-      view_.force_estimate_kN = r->load_cell_kN - frozen_friction_kN_;
+      // Without the resolver: the load cell minus the friction frozen at the fault (within what
+      // the caliper's key friction can hold), never below 0 (a released brake's load cell reads
+      // its friction: -1.1 kN gave an estimate of -2.1 kN, issue 14).
+      const double hw = monitor_.params().eol_friction_half_width_kN;
+      if (std::isfinite(load_filtered_kN_)) {
+        const double prev = load_filtered_kN_;
+        load_filtered_kN_ += (r->load_cell_kN - load_filtered_kN_) * kLoadFilterGain;
+        load_friction_kN_ = std::clamp(load_friction_kN_ + kFrictionShare * (load_filtered_kN_ - prev), -hw, hw);
+      } else {
+        load_filtered_kN_ = r->load_cell_kN;
+      }
+      view_.force_estimate_kN = std::max(0.0, r->load_cell_kN - load_friction_kN_);
       view_.source = EstimateSource::LoadCell;
     } else {
       view_.force_estimate_kN = std::numeric_limits<double>::quiet_NaN();

@@ -25,12 +25,25 @@ void MonitorParams::validate() const {
   positive("residual_persist_s", residual_persist_s);
   positive("residual_reference_s", residual_reference_s);
   positive("residual_change_threshold_kN", residual_change_threshold_kN);
+  positive("residual_sigma_factor", residual_sigma_factor);
+  positive("residual_stats_s", residual_stats_s);
+  require(std::isfinite(residual_speed_free_rev_per_s) && residual_speed_free_rev_per_s >= 0.0,
+          "residual_speed_free_rev_per_s", residual_speed_free_rev_per_s, "must be >= 0");
+  require(std::isfinite(residual_speed_kN_per_rev_per_s) && residual_speed_kN_per_rev_per_s >= 0.0,
+          "residual_speed_kN_per_rev_per_s", residual_speed_kN_per_rev_per_s, "must be >= 0");
+  require(std::isfinite(eol_friction_half_width_kN) && eol_friction_half_width_kN >= 0.0, "eol_friction_half_width_kN",
+          eol_friction_half_width_kN, "must be >= 0");
+  positive("eol_band_kN", eol_band_kN);
+  require(std::isfinite(eol_relative) && eol_relative >= 0.0, "eol_relative", eol_relative, "must be >= 0");
+  require(std::isfinite(eol_speed_kN_per_rev_per_s) && eol_speed_kN_per_rev_per_s >= 0.0, "eol_speed_kN_per_rev_per_s",
+          eol_speed_kN_per_rev_per_s, "must be >= 0");
   require(std::isfinite(curve_min_rev), "curve_min_rev", curve_min_rev, "must be finite");
   require(std::isfinite(curve_max_rev) && curve_max_rev > curve_min_rev, "curve_max_rev", curve_max_rev,
           "must be finite and > curve_min_rev");
   positive("jump_threshold_rev", jump_threshold_rev);
   positive("jump_confirm_s", jump_confirm_s);
   positive("jump_window_s", jump_window_s);
+  positive("jump_max_gap_s", jump_max_gap_s);
   require(stuck_samples >= 2, "stuck_samples", stuck_samples, "must be >= 2");
   positive("stuck_min_travel_rev", stuck_min_travel_rev);
   positive("stuck_min_force_change_kN", stuck_min_force_change_kN);
@@ -41,6 +54,7 @@ void MonitorParams::validate() const {
   require(noise_min_fraction > 0.0 && noise_min_fraction <= 1.0, "noise_min_fraction", noise_min_fraction,
           "must be in (0, 1]");
   require(dropout_samples >= 1, "dropout_samples", dropout_samples, "must be >= 1");
+  require(dropout_clear_samples >= 1, "dropout_clear_samples", dropout_clear_samples, "must be >= 1");
   positive("torque_per_A_Nm", torque_per_A_Nm);
   positive("Nm_per_kN", Nm_per_kN);
   require(torque_fraction_threshold > 0.0 && torque_fraction_threshold < 1.0, "torque_fraction_threshold",
@@ -98,7 +112,7 @@ Part part_of(Finding f) {
 }
 
 FaultMonitor::FaultMonitor(const MonitorParams& params, Target corner)
-    : p_((params.validate(), params)), corner_(corner), residual_(params.curve_min_rev, params.curve_max_rev) {
+    : p_((params.validate(), params)), corner_(corner), residual_(params) {
   if (!corner_slot(corner)) throw std::invalid_argument("FaultMonitor: monitors a corner, not the CCU");
 }
 

@@ -27,6 +27,17 @@ MonitorParams read_monitor_params(Reader& r) {
   p.residual_persist_s = res.number("persist_s", pos);
   p.residual_reference_s = res.number("reference_s", pos);
   p.residual_change_threshold_kN = res.number("change_threshold_kN", pos);
+  p.residual_sigma_factor = res.number("sigma_factor", pos);
+  p.residual_stats_s = res.number("stats_s", pos);
+  p.residual_speed_kN_per_rev_per_s = res.number("speed_kN_per_rev_per_s", config::Range::non_negative());
+  p.residual_speed_free_rev_per_s = res.number("speed_free_rev_per_s", config::Range::non_negative());
+  {
+    auto eol = res.map("end_of_line");
+    p.eol_band_kN = eol.number("band_kN", pos);
+    p.eol_relative = eol.number("relative", config::Range::non_negative());
+    p.eol_speed_kN_per_rev_per_s = eol.number("speed_kN_per_rev_per_s", config::Range::non_negative());
+    eol.finish();
+  }
   p.curve_min_rev = res.number("curve_min_rev");
   p.curve_max_rev = res.number("curve_max_rev");
   p.residual_on_profile_corners = res.boolean("on_profile_corners");
@@ -36,6 +47,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.jump_threshold_rev = j.number("threshold_rev", pos);
   p.jump_confirm_s = j.number("confirm_s", pos);
   p.jump_window_s = j.number("window_s", pos);
+  p.jump_max_gap_s = j.number("max_gap_s", pos);
   j.finish();
 
   auto s = r.map("stuck");
@@ -53,6 +65,7 @@ MonitorParams read_monitor_params(Reader& r) {
 
   auto d = r.map("dropout");
   p.dropout_samples = static_cast<int>(d.integer("samples", 1, 100000));
+  p.dropout_clear_samples = static_cast<int>(d.integer("clear_samples", 1, 100000));
   d.finish();
 
   auto t = r.map("torque");

@@ -3,8 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace bbw::faults {
+
+namespace {
+// The load-cell bias the diagnosis promises to find (docs/faults.md, "Detectability limits"), and
+// the window a bias at or above it is scored in.
+constexpr double kBiasLimit_kN = 1.0;
+constexpr double kBiasWindow_s = 0.5;
+}  // namespace
 
 const char* reaction_to(Finding f) {
   switch (f) {
@@ -37,39 +45,131 @@ Finding finding_from_name(const std::string& name) {
   return Finding::None;
 }
 
-FaultOutcome score_fault(const FaultSpec& f, const std::vector<DetectionEvent>& detections) {
-  FaultOutcome r;
-  r.fault = f;
-  const Part expected = f.type == FaultType::Kill ? Part::Process : f.part;
-  const DetectionEvent* best = nullptr;
-  const DetectionEvent* first = nullptr;
-  for (const DetectionEvent& d : detections) {
-    if (d.corner != f.target || d.finding == Finding::None || d.detected_s < f.at_s - 1e-9) continue;
-    if (first == nullptr || d.detected_s < first->detected_s) first = &d;
-    const bool right = part_of(d.finding) == expected;
-    if (best == nullptr) {
-      best = &d;
-    } else {
-      const bool best_right = part_of(best->finding) == expected;
-      if ((right && !best_right) || (right == best_right && d.detected_s < best->detected_s)) best = &d;
+double detection_window_s(const FaultSpec& f) {
+  switch (f.type) {
+    case FaultType::Bias: return kBiasWindow_s;
+    case FaultType::Drift: {
+      const double rate = std::abs(f.rate_kN_per_s);
+      return (rate > 0.0 ? kBiasLimit_kN / rate : 0.0) + kBiasWindow_s;
     }
+    case FaultType::Stuck: return 1.0;
+    case FaultType::NoiseBurst: return 0.5;
+    case FaultType::Dropout: return 0.1;
+    case FaultType::Offset: return 0.5;
+    case FaultType::TorqueLoss: return 1.0;
+    case FaultType::TotalLoss: return 0.5;
+    case FaultType::Seized: return 0.5;
+    case FaultType::Silence:
+    case FaultType::Delay:
+    case FaultType::LinkCut:
+    case FaultType::Hang:
+    case FaultType::Kill: return 0.1;
   }
-  if (best == nullptr) return r;
-  r.detected = true;
-  r.detected_s = first->detected_s;
-  r.latency_ms = 1e3 * (first->detected_s - f.at_s);
-  r.diagnosis_s = best->detected_s;
-  r.diagnosis_latency_ms = 1e3 * (best->detected_s - f.at_s);
-  // The diagnosis is that part's final finding: a later upgrade of the same part (e.g.
-  // actuator_lost -> actuator_not_releasing once a release is commanded) refines it.
-  const DetectionEvent* last = best;
+  return 0.0;
+}
+
+bool right_finding(const FaultSpec& f, Finding d) {
+  switch (f.type) {
+    case FaultType::Bias:
+    case FaultType::Drift: return d == Finding::LoadCellOffset;
+    case FaultType::Stuck: return d == (f.part == Part::Resolver ? Finding::ResolverStuck : Finding::LoadCellStuck);
+    case FaultType::NoiseBurst: return d == Finding::LoadCellNoisy;
+    case FaultType::Dropout: return d == Finding::LoadCellMissing;
+    case FaultType::Offset: return d == Finding::ResolverOffset;
+    // A loss of 75 % or more leaves the motor below the lost threshold (a quarter of its torque).
+    case FaultType::TorqueLoss:
+      return d == Finding::ActuatorTorqueLoss || (d == Finding::ActuatorLost && f.torque_loss_percent >= 75.0);
+    // Without motor torque a brake whose screw the clamp load cannot back-drive holds its force:
+    // not releasing is that loss seen from outside (the same reaction: out of use).
+    case FaultType::TotalLoss:
+      return d == Finding::ActuatorLost || d == Finding::ActuatorTracking || d == Finding::ActuatorNotReleasing;
+    case FaultType::Seized:
+      return d == Finding::ActuatorLost || d == Finding::ActuatorNotReleasing || d == Finding::ActuatorTracking;
+    case FaultType::Silence:
+    case FaultType::Delay:
+    case FaultType::LinkCut: return d == Finding::LinkLost;
+    // A dead (or hung) process and a dead link look the same until the participant's lease runs out.
+    case FaultType::Hang:
+    case FaultType::Kill: return d == Finding::ProcessLost || d == Finding::LinkLost;
+  }
+  return false;
+}
+
+namespace {
+
+bool explains(const FaultSpec& f, const DetectionEvent& d) {
+  if (f.target != d.corner || !right_finding(f, d.finding) || d.detected_s < f.at_s - 1e-9) return false;
+  const double end_s = f.type == FaultType::Kill && !f.restart_after_s ? std::numeric_limits<double>::infinity() : f.end_s();
+  return d.detected_s <= end_s + detection_window_s(f) + 1e-9;
+}
+
+}  // namespace
+
+RunScore score_run(const std::vector<FaultSpec>& faults, const std::vector<DetectionEvent>& detections) {
+  RunScore score;
   for (const DetectionEvent& d : detections) {
-    if (d.corner == f.target && part_of(d.finding) == part_of(best->finding) && d.detected_s >= last->detected_s) last = &d;
+    if (d.finding == Finding::None) continue;
+    bool explained = false;
+    for (const FaultSpec& f : faults) explained = explained || (!is_ccu(f.target) && explains(f, d));
+    if (!explained) score.false_alarms.push_back(d);
   }
-  r.diagnosis = last->finding;
-  r.correct = part_of(best->finding) == expected;
-  r.reaction = reaction_to(last->finding);
-  return r;
+  for (const FaultSpec& f : faults) {
+    if (is_ccu(f.target)) continue;
+    FaultOutcome r;
+    r.fault = f;
+    const double until_s = f.at_s + detection_window_s(f) + 1e-9;
+    const DetectionEvent* first_right = nullptr;
+    const DetectionEvent* first_any = nullptr;
+    for (const DetectionEvent& d : detections) {
+      if (d.corner != f.target || d.finding == Finding::None || d.detected_s < f.at_s - 1e-9) continue;
+      if (first_any == nullptr || d.detected_s < first_any->detected_s) first_any = &d;
+      if (d.detected_s <= until_s && right_finding(f, d.finding) &&
+          (first_right == nullptr || d.detected_s < first_right->detected_s)) {
+        first_right = &d;
+      }
+    }
+    if (first_right != nullptr) {
+      // The diagnosis is the last right finding for the fault (actuator_lost -> not releasing
+      // once a release is commanded; link_lost -> process_lost when the process is named), made
+      // when its part was first rightly found.
+      const DetectionEvent* last = first_right;
+      for (const DetectionEvent& d : detections) {
+        if (explains(f, d) && d.detected_s >= last->detected_s) last = &d;
+      }
+      const DetectionEvent* made = last;
+      for (const DetectionEvent& d : detections) {
+        if (explains(f, d) && part_of(d.finding) == part_of(last->finding) && d.detected_s < made->detected_s) made = &d;
+      }
+      r.diagnosis = last->finding;
+      r.diagnosis_s = made->detected_s;
+      r.diagnosis_latency_ms = 1e3 * (made->detected_s - f.at_s);
+      r.reaction = reaction_to(last->finding);
+    } else if (first_any != nullptr) {
+      // Shown, not counted: what the corner raised instead (or too late).
+      r.diagnosis = first_any->finding;
+      r.diagnosis_s = first_any->detected_s;
+      r.diagnosis_latency_ms = 1e3 * (first_any->detected_s - f.at_s);
+      r.reaction = reaction_to(first_any->finding);
+    }
+    if (first_right != nullptr) {
+      r.detected = true;
+      r.detected_s = first_right->detected_s;
+      r.latency_ms = 1e3 * (first_right->detected_s - f.at_s);
+      bool clean = true;
+      for (const DetectionEvent& d : score.false_alarms) {
+        clean = clean && !(d.corner == f.target && d.detected_s >= f.at_s - 1e-9 && d.detected_s <= until_s);
+      }
+      r.correct = clean;
+    }
+    score.outcomes.push_back(r);
+  }
+  return score;
+}
+
+FaultOutcome score_fault(const FaultSpec& f, const std::vector<DetectionEvent>& detections) {
+  RunScore s = score_run({f}, detections);
+  if (s.outcomes.empty()) throw std::invalid_argument("score_fault: a CCU kill is scored by score_ccu_kill");
+  return s.outcomes.front();
 }
 
 FaultOutcome score_ccu_kill(const FaultSpec& f, const std::vector<double>& ccu_lost_s) {

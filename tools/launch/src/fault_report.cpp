@@ -48,9 +48,7 @@ double share(const std::vector<TimelinePoint>& tl, double from_s, double to_s) {
 
 }  // namespace
 
-std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, const std::vector<Detection>& detections,
-                                       const std::map<std::string, double>& ccu_lost_s,
-                                       const std::vector<TimelinePoint>& timeline, double run_end_s) {
+std::vector<faults::DetectionEvent> detection_events(const std::vector<Detection>& detections) {
   // ccu.stats names corners and findings; the scorer takes them typed.
   std::vector<faults::DetectionEvent> events;
   for (const Detection& d : detections) {
@@ -60,11 +58,23 @@ std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, co
     if (finding == faults::Finding::None) throw std::runtime_error("detection of an unknown finding '" + d.finding + "'");
     events.push_back({*corner, finding, d.onset_s, d.detected_s});
   }
+  return events;
+}
+
+std::vector<faults::DetectionEvent> false_alarms(const faults::FaultSchedule& schedule, const std::vector<Detection>& detections) {
+  return faults::score_run(schedule.faults, detection_events(detections)).false_alarms;
+}
+
+std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, const std::vector<Detection>& detections,
+                                       const std::map<std::string, double>& ccu_lost_s,
+                                       const std::vector<TimelinePoint>& timeline, double run_end_s) {
+  const faults::RunScore score = faults::score_run(schedule.faults, detection_events(detections));
   std::vector<double> lost;
   for (const auto& [corner, t] : ccu_lost_s) lost.push_back(t);
   std::vector<FaultResult> out;
+  std::size_t next = 0;  // score.outcomes: the corner faults in schedule order
   for (const faults::FaultSpec& f : schedule.faults) {
-    FaultResult r = faults::is_ccu(f.target) ? faults::score_ccu_kill(f, lost) : faults::score_fault(f, events);
+    FaultResult r = faults::is_ccu(f.target) ? faults::score_ccu_kill(f, lost) : score.outcomes.at(next++);
     r.delivered_share = share(timeline, f.at_s, std::min(f.end_s(), run_end_s));
     out.push_back(r);
   }

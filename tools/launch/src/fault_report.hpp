@@ -32,6 +32,11 @@ std::vector<TimelinePoint> build_timeline(const scenario::Scenario& s,
 // Scored by the one fault scorer (bbw/faults/outcome.hpp), shared with the closed-loop tests.
 using FaultResult = faults::FaultOutcome;
 
+// ccu.stats' detections, typed. Throws std::runtime_error on a corner or finding bbw does not know.
+std::vector<faults::DetectionEvent> detection_events(const std::vector<Detection>& detections);
+// The detections no injected fault explains (faults::score_run): false alarms.
+std::vector<faults::DetectionEvent> false_alarms(const faults::FaultSchedule& schedule, const std::vector<Detection>& detections);
+
 // ccu_lost_s: per corner, the simulated time its watchdog found the CCU lost (< 0: never).
 // Throws std::runtime_error on a detection whose corner or finding bbw does not know.
 std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, const std::vector<Detection>& detections,

@@ -182,7 +182,8 @@ RunTotals write_run_summary(const CompletedRun& run) {
     const auto table = csv::read(ccu_dir + "/ccu_" + c.name + ".csv", ccu_log_columns());
     const auto m = summarize_corner(c.name, table);
     const long long pub = static_cast<long long>(corner_sum(&CS::samples_published));
-    // Not receivable: still held back by an injected delay, or sent after the CCU died.
+    // Not receivable: still held back by an injected delay, or sent after the scheduled CCU kill
+    // froze the CCU (counted by the corner from the schedule, never from its watchdog's guess).
     const long long in_flight =
         static_cast<long long>(corner_sum(&CS::samples_in_flight) + corner_sum(&CS::samples_without_ccu));
     const long long rec = static_cast<long long>(at_ccu.samples_received);
@@ -305,6 +306,17 @@ RunTotals write_run_summary(const CompletedRun& run) {
         .value("correct", f.correct)
         .value("reaction", std::string(f.reaction))
         .value("delivered_share", f.delivered_share)
+        .end_object();
+  }
+  j.end_array();
+  // Detections no injected fault explains (the one scorer, bbw/faults/outcome.hpp).
+  j.begin_array("false_alarms");
+  for (const auto& d : false_alarms(*run.schedule, detections)) {
+    j.begin_object()
+        .value("corner", std::string(faults::to_string(d.corner)))
+        .value("finding", std::string(faults::to_string(d.finding)))
+        .value("onset_s", d.onset_s)
+        .value("detected_s", d.detected_s)
         .end_object();
   }
   j.end_array();

@@ -7,7 +7,8 @@
 namespace bbw::faults {
 
 void JumpDetector::update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a) {
-  if (!c.have_prev) return;
+  // Across a gap (samples the guard refused, a lost link) the speed no longer predicts the step.
+  if (!c.have_prev || c.dt_s > p.jump_max_gap_s) return;
   const double t = c.r.time_s;
   const double predicted = 0.5 * (c.prev.speed_rev_per_s + c.r.speed_rev_per_s) * c.dt_s;
   const double step = c.r.position_rev - c.prev.position_rev;

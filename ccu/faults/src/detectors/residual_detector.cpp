@@ -7,19 +7,76 @@
 
 namespace bbw::faults {
 
+ResidualDetector::ResidualDetector(const MonitorParams& p)
+    : curve_min_rev_(p.curve_min_rev), curve_max_rev_(p.curve_max_rev), trusted_min_rev_(p.curve_min_rev) {
+  if (p.eol_curve) eol_.emplace(*p.eol_curve);
+}
+
 void ResidualDetector::update(const CornerReading& r, const calibration::Estimate& e, const MonitorParams& p,
                               DiagnosisArbiter& a, NoiseDetector& noise, const StuckDetector& stuck,
                               const JumpDetector& jump) {
   const double t = r.time_s;
   residual_kN_ = e.force_kN - e.curve_force_kN;
-  noise.update(residual_kN_, t, p, a);
-  if (r.position_rev < curve_min_rev_ || r.position_rev > curve_max_rev_) {
+  // Below the trusted range (released, no clamp load) the key friction snaps back and forth with
+  // small motions by up to its full width within milliseconds: that is not sensor noise.
+  if (r.position_rev >= trusted_min_rev_ || !eol_) noise.update(residual_kN_, t, p, a);
+  // With an end-of-line curve, a calibrated corner's residual is its estimate (load cell minus
+  // the calibrator's friction) against that curve, everywhere above the trusted minimum: the
+  // fitted cubic is an approximation fitted to wherever the cycles went, the end-of-line curve
+  // holds over the whole stroke. Without one, the calibrator's curve where the fits had data
+  // (before the first fit: its initial curve against the uncalibrated threshold).
+  const bool above_min = r.position_rev >= trusted_min_rev_;
+  const bool fitted_here = eol_ ? e.calibrated && above_min : r.position_rev >= curve_min_rev_ && r.position_rev <= curve_max_rev_;
+  const bool eol_here = !fitted_here && eol_ && above_min;
+  if (!fitted_here && !eol_here) {
     suspect_ = false;  // no trusted curve here
     residual_kN_ = std::numeric_limits<double>::quiet_NaN();
     change_kN_ = std::numeric_limits<double>::quiet_NaN();
+    threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
     have_reference_ = false;  // restarts where the curve is trusted again
     return;
   }
+  double thr = 0.0, change_thr = 0.0;
+  if (eol_here) {
+    // The end-of-line curve at the measured temperature, with its band.
+    const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
+    const double eol_kN = eol_->force_kN(r.position_rev, temperature_C, 0.0);
+    residual_kN_ = r.load_cell_kN - eol_kN;
+    thr = p.eol_friction_half_width_kN + p.eol_band_kN + p.eol_relative * std::abs(eol_kN) +
+          p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s);
+    if (!eol_mode_) have_reference_ = false;
+    eol_mode_ = true;
+  } else if (!e.calibrated) {
+    thr = p.uncalibrated_residual_threshold_kN;  // no end-of-line curve: the initial curve
+    eol_mode_ = false;
+  } else {
+    if (eol_) {
+      const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
+      // The calibrator's friction, within what the caliper's key friction can hold (a fit that
+      // explains more than the end-of-line width as friction is wrong, not the load cell).
+      const double hw = p.eol_friction_half_width_kN;
+      const double friction_kN = std::clamp(e.friction_kN, -hw, hw);
+      residual_kN_ = e.force_kN + e.friction_kN - friction_kN - eol_->force_kN(r.position_rev, temperature_C, 0.0);
+    }
+    if (!std::isfinite(ms_residual_kN2_)) {
+      // The first fit's friction model may be poor: start from the end-of-line band (or, without
+      // an end-of-line curve, from the fixed thresholds) and learn the corner's own from there.
+      const double start_kN = eol_ ? p.eol_friction_half_width_kN + p.eol_band_kN : p.residual_threshold_kN;
+      ms_residual_kN2_ = std::pow(start_kN / p.residual_sigma_factor, 2);
+      ms_change_kN2_ = std::pow(std::max(p.residual_change_threshold_kN, eol_ ? start_kN : 0.0) / p.residual_sigma_factor, 2);
+      stats_time_s_ = t;
+    }
+    thr = std::max(p.residual_threshold_kN, p.residual_sigma_factor * std::max(fit_rms_kN_, std::sqrt(ms_residual_kN2_)));
+    change_thr = std::max(p.residual_change_threshold_kN, p.residual_sigma_factor * std::max(fit_rms_kN_, std::sqrt(ms_change_kN2_)));
+    // Unmodelled speed effects (viscous friction, sensor delay) grow with speed.
+    // Beyond the speeds a force loop corrects at (its reaction to a step must stay visible).
+    const double speed_kN = p.residual_speed_kN_per_rev_per_s * std::max(0.0, std::abs(r.speed_rev_per_s) - p.residual_speed_free_rev_per_s);
+    thr += speed_kN;
+    change_thr += speed_kN;
+    if (eol_mode_) have_reference_ = false;
+    eol_mode_ = false;
+  }
+  threshold_kN_ = thr;
   // The first accepted fit replaces the initial curve and adds the friction model, which moves
   // the residual by itself: the change rule restarts from the calibrated residual, unless a
   // fault is already suspected. (Later fits move it little; restarting at each of them too made
@@ -32,9 +89,16 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     reference_time_s_ = t;
   }
   change_kN_ = residual_kN_ - reference_kN_;
-  const double thr = e.calibrated ? p.residual_threshold_kN : p.uncalibrated_residual_threshold_kN;
-  const bool over = p.residual_findings && (std::abs(residual_kN_) > thr ||
-                                            (e.calibrated && std::abs(change_kN_) > p.residual_change_threshold_kN));
+  const bool change_rule = !eol_here && e.calibrated;
+  const bool over = p.residual_findings &&
+                    (std::abs(residual_kN_) > thr || (change_rule && std::abs(change_kN_) > change_thr));
+  if (!over && !eol_here && e.calibrated && std::isfinite(ms_residual_kN2_) && std::isfinite(change_kN_)) {
+    // Healthy: the corner's own residual statistics follow (never while suspected).
+    const double w = -std::expm1(-std::max(0.0, t - stats_time_s_) / p.residual_stats_s);
+    ms_residual_kN2_ += (residual_kN_ * residual_kN_ - ms_residual_kN2_) * w;
+    ms_change_kN2_ += (change_kN_ * change_kN_ - ms_change_kN2_) * w;
+  }
+  stats_time_s_ = t;
   if (!over) {
     suspect_ = false;
     const double dt = std::max(0.0, t - reference_time_s_);

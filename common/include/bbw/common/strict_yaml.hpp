@@ -95,7 +95,7 @@ class Reader {
   std::string choice_or(const std::string& key, const std::string& fallback,
                         const std::vector<std::string>& allowed);
   std::vector<double> numbers(const std::string& key, const Range& range = Range::any());
-  // A list of strings (every entry a scalar).
+  // A non-empty list of strings.
   std::vector<std::string> strings(const std::string& key);
 
   Reader map(const std::string& key);

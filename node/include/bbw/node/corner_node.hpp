@@ -66,7 +66,7 @@ struct CornerStats {
   std::uint64_t samples_suppressed = 0;  // not sent: injected network silence
   std::uint64_t samples_delayed = 0;     // sent late: injected network delay
   std::uint64_t samples_in_flight = 0;   // still held back by a delay at the end
-  std::uint64_t samples_without_ccu = 0; // published while the CCU was lost (nobody to receive them)
+  std::uint64_t samples_without_ccu = 0; // published after the scheduled CCU kill (nobody to receive them)
   double ccu_lost_s = -1.0;              // simulated time the watchdog found the CCU lost (-1: never)
   double default_force_s = -1.0;         // ... and went to the default clamp force
   std::uint64_t first_step = 0;          // the period this incarnation started at
@@ -155,6 +155,7 @@ class CornerNode {
   faults::DelayQueue<msg::MeasurementSample, 1024> outbox_;
   std::uint64_t resume_step_ = 0;
   bool ccu_lost_ = false;
+  std::optional<double> ccu_kill_at_s_;  // the schedule's CCU kill, if any
   bool started_ = false;
   faults::WatchdogMode last_mode_ = faults::WatchdogMode::Normal;
 

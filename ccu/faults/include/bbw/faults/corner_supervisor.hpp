@@ -67,6 +67,7 @@ class CornerSupervisor {
   Target corner() const { return corner_; }
 
  private:
+  void resume_after_dropout();
   void react_to_new_findings();
   void rejoin();
   void refresh_view(const CornerReading* r, const SampleCheck* c, const calibration::Estimate* e);
@@ -88,6 +89,10 @@ class CornerSupervisor {
   calibration::Curve trusted_curve_;
   double last_friction_kN_ = 0.0;
   double frozen_friction_kN_ = 0.0;
+  // After a resolver fault: the key friction followed from the load cell's own motion (a play in
+  // force: it absorbs a change of the load up to its width, then the clamp force moves).
+  double load_friction_kN_ = 0.0;
+  double load_filtered_kN_ = std::numeric_limits<double>::quiet_NaN();
   double fed_min_rev_ = std::numeric_limits<double>::infinity();   // positions the calibrator saw
   double fed_max_rev_ = -std::numeric_limits<double>::infinity();
   std::uint64_t restarts_ = 0;

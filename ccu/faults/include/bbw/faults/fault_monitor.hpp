@@ -31,6 +31,7 @@
 #include "bbw/faults/detectors/torque_detector.hpp"
 #include "bbw/faults/detectors/tracking_detector.hpp"
 #include "bbw/faults/finding.hpp"
+#include "bbw/plant/params.hpp"
 
 namespace bbw::faults {
 
@@ -45,8 +46,29 @@ struct MonitorParams {
   // frozen while a fault is suspected) beyond residual_change_threshold_kN is also a
   // disagreement (once calibrated): it catches a step whose sign the standing calibration error
   // partly cancels, or that the local loop's reaction partly hides.
-  double residual_reference_s = 0.5;
+  double residual_reference_s = 0.1;
   double residual_change_threshold_kN = 0.45;
+  // Once calibrated, both thresholds scale with the corner's own model uncertainty (never below
+  // the fixed values above): residual_sigma_factor times the larger of the residual RMS of its
+  // last accepted fit and the RMS of its own healthy residual (resp. of the residual's change)
+  // over residual_stats_s, updated only while nothing is suspected. docs/faults.md, "Thresholds".
+  double residual_sigma_factor = 4.0;
+  double residual_stats_s = 5.0;
+  double residual_speed_kN_per_rev_per_s = 0.3;  // added to both, times |speed| beyond:
+  double residual_speed_free_rev_per_s = 3.0;
+  // The end-of-line curve: the caliper's own clamp curve with its temperature coefficients, as
+  // measured at the end of its production line (CcuCore sets it from the scenario's plant, as it
+  // sets the actuator model; absent: the rule is off). Before the first accepted fit, and
+  // outside the positions the fits had data for (a hard stop beyond them), the residual is
+  // load cell - eol(position, measured temperature) against the band
+  //   eol_friction_half_width_kN + eol_band_kN + eol_relative |eol| + eol_speed |speed|
+  // (key friction not yet modelled, noise, the curve's spread with temperature and ageing,
+  // unmodelled speed effects: viscous friction, sensor delay).
+  std::optional<plant::ClampCurveParams> eol_curve;
+  double eol_friction_half_width_kN = 1.0;
+  double eol_band_kN = 0.5;
+  double eol_relative = 0.03;
+  double eol_speed_kN_per_rev_per_s = 0.3;
   // Where the curve is trusted: the calibrator's range (CornerSupervisor copies x_min_rev and
   // x_max_rev of the calibrator config here). Outside it the cubic is an extrapolation.
   double curve_min_rev = 1.0;
@@ -61,6 +83,7 @@ struct MonitorParams {
   double jump_threshold_rev = 0.01;
   double jump_confirm_s = 0.01;     // a jump not undone within this is an offset
   double jump_window_s = 0.05;      // a jump this recent explains a residual as the resolver's
+  double jump_max_gap_s = 0.003;    // no prediction across a longer gap between usable samples
 
   // Stuck channels: exactly repeated readings while the other channel moves.
   int stuck_samples = 20;
@@ -76,6 +99,9 @@ struct MonitorParams {
 
   // Dropout: consecutive samples without a load-cell value.
   int dropout_samples = 5;
+  // A dropout ends: after this many consecutive samples with a value again the load-cell finding
+  // (a dropout only) clears, and the calibrator it stopped resumes from the last good curve.
+  int dropout_clear_samples = 200;
 
   // Actuator torque balance: the torque the axial load and the acceleration need,
   // load * Nm_per_kN + J 2 pi a, against the torque the measured current should make,
@@ -126,12 +152,16 @@ class FaultMonitor {
   // Samples arrived again after a link or process loss; cleared by take_rejoin().
   bool rejoined() const { return link_.rejoined(); }
   bool take_rejoin() { return link_.take_rejoin(); }
+  // A dropout finding cleared (its values are back); true once per clearing.
+  bool take_load_cell_cleared() { return dropout_.take_cleared(); }
   // Whether the last loss was the process (liveliness), so its sequence starts again.
   bool process_was_lost() const { return link_.process_was_lost(); }
   // Delivered / expected torque, from the last torque check (1 until one ran).
   double torque_fraction() const { return torque_.fraction(); }
-  // Narrows the residual check to where the calibrator's fits had data.
+  // Narrows the calibrated residual check to where the calibrator's fits had data (the
+  // end-of-line band covers the rest), and scales its thresholds with the fit's residual RMS.
   void set_curve_range(double min_rev, double max_rev);
+  void set_fit_rms(double fit_rms_kN) { residual_.set_fit_rms(fit_rms_kN); }
   // The last residual inside the curve's range (NaN outside it or before the first).
   double last_residual_kN() const { return residual_.residual_kN(); }
   // The last residual minus its reference level (NaN where the residual is).

@@ -21,21 +21,41 @@ struct DetectionEvent {
 
 struct FaultOutcome {
   FaultSpec fault;
-  bool detected = false;        // anything detected on the faulty corner at or after the injection
-  double detected_s = 0.0;      // the first such detection (CCU kill: the first watchdog)
+  // Strict (issue 14): detected only by a right finding for the fault's type (right_finding) on
+  // its corner within the type's stated window after the injection (detection_window_s).
+  bool detected = false;
+  double detected_s = 0.0;      // the first right finding in the window (CCU kill: the first watchdog)
   double latency_ms = 0.0;      // detected_s - at_s
-  double diagnosis_s = 0.0;     // when the diagnosis below was made (the right part's, if any)
+  double diagnosis_s = 0.0;     // when the diagnosis below was made
   double diagnosis_latency_ms = 0.0;
-  Finding diagnosis = Finding::None;  // the diagnosed part's final finding
+  Finding diagnosis = Finding::None;  // the right finding's final form (an upgrade refines it); else the first finding
   bool ccu_lost = false;        // CCU kill: the diagnosis is the corners' "CCU lost"
-  bool correct = false;         // the diagnosis names the injected part (CCU kill: every corner saw it)
+  // detected, and nothing on the corner within the window that no injected fault explains
+  // (CCU kill: every corner saw it).
+  bool correct = false;
   const char* reaction = "none";
   double delivered_share = 1.0; // delivered / demanded total clamp force while it lasted (caller)
 };
 
-// A corner fault against the detections (any order): the diagnosis prefers the injected part
-// (a process kill: Part::Process), then the earliest; a later finding of the same part refines
-// it (actuator_lost -> actuator_not_releasing). A wrong part is a detection, not a correct one.
+// The stated detection window of a fault (docs/faults.md, "Scoring"): a right finding later than
+// at_s + this is a miss. Drift: the time the drift needs to reach the bias limit, plus the bias
+// window.
+double detection_window_s(const FaultSpec& fault);
+// Whether `finding` names `fault` rightly (its part and type; e.g. a bias or drift is a
+// load_cell_offset, a seized actuator is actuator_lost or actuator_not_releasing).
+bool right_finding(const FaultSpec& fault, Finding finding);
+
+// A run's faults against every detection: per fault its outcome, and the detections that no
+// injected fault explains (false alarms). A detection is explained by a fault on its corner when
+// it is a right finding for it at or after the injection and before the fault's end plus its
+// window (a late right finding is a miss, not a false alarm).
+struct RunScore {
+  std::vector<FaultOutcome> outcomes;         // in schedule order (CCU kills scored elsewhere: not here)
+  std::vector<DetectionEvent> false_alarms;   // in detection order
+};
+RunScore score_run(const std::vector<FaultSpec>& faults, const std::vector<DetectionEvent>& detections);
+
+// One corner fault alone (score_run with that fault only).
 FaultOutcome score_fault(const FaultSpec& fault, const std::vector<DetectionEvent>& detections);
 
 // A CCU kill against the corners' watchdogs: `ccu_lost_s` per corner, when it found the CCU lost

@@ -15,7 +15,7 @@ struct GuardLimits {
   double position_min_rev = -1.0;
   double position_max_rev = 10.0;
   double speed_abs_max_rev_per_s = 200.0;
-  double load_cell_min_kN = -5.0;
+  double load_cell_min_kN = -10.0;  // key friction (2 kN) + viscous friction at full speed (issue 14)
   double load_cell_max_kN = 80.0;
   double current_abs_max_A = 80.0;
   // Within one incarnation (between rejoins) a corner's sequence and time move forward by what

@@ -1,24 +1,31 @@
-// Analytic redundancy: r = (load cell - friction estimate) - curve(position), where the curve is
-// trusted. A residual beyond its threshold (wider before the first accepted fit), or a change
-// against its own recent level beyond residual_change_threshold_kN, that persists is a
-// disagreement; isolation names the channel that explains it (a frozen position: ResolverStuck;
+// Analytic redundancy: r = (load cell - friction estimate) - curve(position) where the fitted
+// curve is trusted (calibrated, inside the positions the fits had data for), against a threshold
+// scaled by the fit's residual RMS; elsewhere (before the first fit, beyond the fitted range)
+// r = load cell - end-of-line curve(position, temperature) against the end-of-line band
+// (MonitorParams). A residual beyond its threshold, or (calibrated) a change against its own
+// recent level beyond the change threshold, that persists is a disagreement; isolation names the channel that explains it (a frozen position: ResolverStuck;
 // a frozen load cell: LoadCellStuck; a recent position jump: ResolverOffset; else
 // LoadCellOffset). Feeds the noise detector with every residual.
 #pragma once
 
+#include <cmath>
 #include <limits>
+#include <optional>
 
 #include "bbw/calibration/calibrator.hpp"
 #include "bbw/faults/detectors/detector.hpp"
 #include "bbw/faults/detectors/jump_detector.hpp"
 #include "bbw/faults/detectors/noise_detector.hpp"
 #include "bbw/faults/detectors/stuck_detector.hpp"
+#include "bbw/plant/clamp_curve.hpp"
 
 namespace bbw::faults {
 
+struct MonitorParams;
+
 class ResidualDetector {
  public:
-  ResidualDetector(double curve_min_rev, double curve_max_rev) : curve_min_rev_(curve_min_rev), curve_max_rev_(curve_max_rev) {}
+  explicit ResidualDetector(const MonitorParams& p);
   void update(const CornerReading& r, const calibration::Estimate& e, const MonitorParams& p, DiagnosisArbiter& a,
               NoiseDetector& noise, const StuckDetector& stuck, const JumpDetector& jump);
   void on_rejoin() { suspect_ = false; }
@@ -26,7 +33,18 @@ class ResidualDetector {
     curve_min_rev_ = min_rev;
     curve_max_rev_ = max_rev;
   }
+  // At an accepted fit: its residual RMS, and a snapshot of the healthy residual's statistics
+  // (the thresholds use these until the next fit, so a slow fault cannot widen them).
+  void set_fit_rms(double fit_rms_kN) {
+    fit_rms_kN_ = fit_rms_kN;
+    if (std::isfinite(ms_residual_kN2_)) {
+      sigma_residual_kN_ = std::sqrt(ms_residual_kN2_);
+      sigma_change_kN_ = std::sqrt(ms_change_kN2_);
+    }
+  }
   double residual_kN() const { return residual_kN_; }
+  // The threshold the last residual was held against (kN).
+  double threshold_kN() const { return threshold_kN_; }
   // A disagreement is under way but not yet confirmed (persist_s).
   bool suspect() const { return suspect_; }
   double change_kN() const { return change_kN_; }
@@ -42,6 +60,18 @@ class ResidualDetector {
   double reference_time_s_ = 0.0;
   double curve_min_rev_;
   double curve_max_rev_;
+  double trusted_min_rev_;  // the calibrator's range: below it no rule (contact, soft pads)
+  double fit_rms_kN_ = 0.0;
+  double threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
+  bool eol_mode_ = false;   // the last residual was against the end-of-line curve
+  // The corner's healthy calibrated residual: mean squares of the residual and of its change
+  // (low-passed over residual_stats_s, while nothing is suspected; NaN until calibrated).
+  double ms_residual_kN2_ = std::numeric_limits<double>::quiet_NaN();
+  double ms_change_kN2_ = std::numeric_limits<double>::quiet_NaN();
+  double stats_time_s_ = 0.0;
+  double sigma_residual_kN_ = 0.0;  // snapshots at the last accepted fit
+  double sigma_change_kN_ = 0.0;
+  std::optional<plant::ClampCurve> eol_;
 };
 
 }  // namespace bbw::faults

@@ -1,0 +1,154 @@
+// The campaign's pure core (tools/campaign/src): strict spec, seeded draws that load as fault
+// scenarios, and the statistics of the report.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+#include <string>
+
+#include "bbw/common/strict_yaml.hpp"
+#include "bbw/faults/schedule_yaml.hpp"
+#include "draw.hpp"
+#include "metrics.hpp"
+#include "spec.hpp"
+
+namespace bbw::campaign {
+namespace {
+
+std::string src(const std::string& rel) { return std::string(BBW_TEST_SOURCE_DIR) + "/" + rel; }
+
+TEST(CampaignSpec, EveryShippedSpecLoads) {
+  for (const char* f : {"config/campaigns/ci.yaml", "config/campaigns/tune.yaml", "config/campaigns/score.yaml"}) {
+    const CampaignSpec s = load_campaign_spec(src(f));
+    EXPECT_GT(s.runs, 0) << f;
+    EXPECT_EQ(s.profiles.size(), 6u) << f;
+    EXPECT_EQ(s.fault_kinds.size(), 12u) << f;
+  }
+  EXPECT_NE(load_campaign_spec(src("config/campaigns/tune.yaml")).seed, load_campaign_spec(src("config/campaigns/score.yaml")).seed)
+      << "tuned on one seed, scored on another";
+}
+
+const char* kGood = R"(name: t
+seed: 3
+runs: 10
+fault_free_share: 0.2
+duration_s: [12, 14]
+population: {spec: POP, members: 5}
+temperatures_C: [28, 54]
+effects_share: 0.3
+profiles: [city, hard_stop_release]
+faults:
+  kinds: [bias, seized]
+  onsets: [before_first_fit, hard_stop, normal]
+  two_faults_share: 0.5
+  same_corner_share: 0.5
+  intermittent_share: 0.3
+)";
+
+std::string good() {
+  std::string s = kGood;
+  s.replace(s.find("POP"), 3, src("config/population/scoring.yaml"));
+  return s;
+}
+
+TEST(CampaignSpec, BadInputNamesLineKeyAndRule) {
+  EXPECT_NO_THROW(load_campaign_spec_string(good(), "t.yaml"));
+  auto fails = [](const std::string& text, const std::string& needle) {
+    try {
+      load_campaign_spec_string(text, "t.yaml");
+      ADD_FAILURE() << "accepted: " << needle;
+    } catch (const config::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  std::string s = good();
+  fails(s + "extra: 1\n", "extra");
+  s = good();
+  s.replace(s.find("[city, hard_stop_release]"), 25, "[city, bogus]");
+  fails(s, "t.yaml:9: key 'profiles'");
+  s = good();
+  s.replace(s.find("[12, 14]"), 8, "[14, 12]");
+  fails(s, "min must be <= max");
+  s = good();
+  s.replace(s.find("[bias, seized]"), 14, "[bias, bias]");
+  fails(s, "listed twice");
+}
+
+CampaignSpec spec() { return load_campaign_spec_string(good(), "t.yaml"); }
+
+TEST(CampaignDraw, ARunDependsOnItsIndexAndTheSeedOnly) {
+  CampaignSpec a = spec();
+  CampaignSpec b = spec();
+  b.runs = 1000;  // more runs: run 5 stays the same
+  const std::string plant = src("config/plant/ecaliper.yaml");
+  EXPECT_EQ(scenario_yaml(a, draw_run(a, 5), plant), scenario_yaml(b, draw_run(b, 5), plant));
+  CampaignSpec c = spec();
+  c.seed = 4;
+  EXPECT_NE(scenario_yaml(a, draw_run(a, 5), plant), scenario_yaml(c, draw_run(c, 5), plant));
+  EXPECT_THROW(draw_run(a, 10), std::out_of_range);
+}
+
+TEST(CampaignDraw, EveryDrawLoadsAsAFaultScenarioWithinTheSpec) {
+  CampaignSpec s = spec();
+  s.runs = 300;
+  const std::string plant = src("config/plant/ecaliper.yaml");
+  std::set<std::string> onsets, profiles;
+  int fault_free = 0, two = 0, same_corner = 0, intermittent = 0;
+  for (int i = 0; i < s.runs; ++i) {
+    const RunPlan r = draw_run(s, i);
+    const auto fs = faults::load_fault_scenario_string(scenario_yaml(s, r, plant), "run.yaml");
+    ASSERT_EQ(fs.faults.faults.size(), r.faults.size());
+    fault_free += r.fault_free ? 1 : 0;
+    EXPECT_EQ(r.fault_free, r.faults.empty());
+    profiles.insert(to_string(r.profile));
+    for (double t : r.temperature_C) EXPECT_TRUE(t >= 28.0 && t <= 54.0) << t;
+    if (r.faults.size() == 2) {
+      ++two;
+      same_corner += r.faults[0].spec.target == r.faults[1].spec.target ? 1 : 0;
+    }
+    for (const PlannedFault& f : r.faults) {
+      onsets.insert(to_string(f.onset));
+      intermittent += f.spec.duration_s && f.kind != FaultKind::Seized ? 1 : 0;
+      if (f.kind == FaultKind::Bias) {
+        EXPECT_GE(std::abs(f.spec.bias_kN), detectability_limit(FaultKind::Bias));
+        EXPECT_LE(std::abs(f.spec.bias_kN), kind_max_magnitude(FaultKind::Bias));
+      }
+      if (f.onset == Onset::BeforeFirstFit) {
+        EXPECT_LE(f.spec.at_s, 1.8);  // 0.3-1.5 s, a second fault up to 0.3 s later
+      }
+      if (f.onset == Onset::HardStop && !r.hard_stops.empty()) {
+        bool inside = false;
+        for (const auto& h : r.hard_stops) inside = inside || (f.spec.at_s >= h.first && f.spec.at_s <= h.second);
+        EXPECT_TRUE(inside || f.spec.at_s >= 3.0) << "run " << i;
+      }
+    }
+  }
+  EXPECT_EQ(fault_free, 60);
+  EXPECT_EQ(onsets.size(), 3u);
+  EXPECT_EQ(profiles.size(), 2u);
+  EXPECT_GT(two, 20);
+  EXPECT_GT(same_corner, 5);
+  EXPECT_GT(intermittent, 10);
+}
+
+TEST(CampaignStats, IntervalsAndBoundsMatchTheTextbook) {
+  // Clopper-Pearson for 0/10: [0, 0.3085]; 10/10: [0.6915, 1]; 5/10: [0.1871, 0.8129].
+  EXPECT_NEAR(clopper_pearson95(0, 10).hi, 0.30850, 1e-4);
+  EXPECT_NEAR(clopper_pearson95(10, 10).lo, 0.69150, 1e-4);
+  EXPECT_NEAR(clopper_pearson95(5, 10).lo, 0.18709, 1e-4);
+  EXPECT_NEAR(clopper_pearson95(5, 10).hi, 0.81291, 1e-4);
+  // Wilson for 1000/1000: lower 0.99617.
+  EXPECT_NEAR(wilson95(1000, 1000).lo, 0.99617, 1e-4);
+  EXPECT_NEAR(wilson95(5, 10).lo, 0.23659, 1e-4);
+  // Poisson one-sided 95 % upper bounds: 0 -> 2.996, 1 -> 4.744, 5 -> 10.513.
+  EXPECT_NEAR(poisson_upper95(0), 2.9957, 1e-3);
+  EXPECT_NEAR(poisson_upper95(1), 4.7439, 1e-3);
+  EXPECT_NEAR(poisson_upper95(5), 10.513, 1e-2);
+  EXPECT_DOUBLE_EQ(percentile({3.0, 1.0, 2.0}, 0.5), 2.0);
+  EXPECT_DOUBLE_EQ(percentile({1.0, 2.0, 3.0, 4.0, 5.0}, 0.95), 4.8);
+  EXPECT_TRUE(std::isnan(percentile({}, 0.5)));
+  EXPECT_THROW(wilson95(3, 2), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace bbw::campaign
