@@ -86,7 +86,7 @@ TEST(VehicleScenario, TheProcessListIsCheckedWithItsLine) {
   expect_error(t, "runs pedal too");
   t = text;
   t.replace(t.find("processes: [ccu, FL, FR, RL, RR, vehicle, pedal]"), 48, "processes: ccu");
-  expect_error(t, "must be a list of strings");
+  expect_error(t, "list of strings");
   std::filesystem::remove(file);
 }
 
