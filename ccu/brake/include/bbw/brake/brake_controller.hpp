@@ -43,6 +43,7 @@ struct BrakeOutput {
   double decel_request_g = 0.0;
   double speed_estimate_m_s = 0.0;
   bool split_mu = false;
+  bool yaw_limited = false;      // split-mu or a lost corner's yaw limitation acts
   std::uint64_t pedal_disagreements = 0;
 };
 
@@ -61,7 +62,9 @@ class BrakeController {
   SpeedEstimator speed_;
   std::array<SlipController, 4> slip_;
   double ax_filt_ = 0.0;
+  static std::size_t lost_corner(const BrakeMeasurements& m);  // the one unavailable corner, else 4
   double split_s_ = 0.0;        // time since split-mu was detected
+  double lost_s_ = 0.0;         // time since a lost corner's yaw limitation began
   bool split_ = false;
   BrakeOutput out_;
 };

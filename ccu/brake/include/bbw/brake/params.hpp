@@ -56,6 +56,13 @@ struct SlipControlParams {
   double dither_settle_s = 0.08;
   double search_step = 0.01;
   double search_threshold_mu = 0.005;
+  // High-to-low mu jump: under control, a wheel decelerating faster than this (m/s^2 at the
+  // rim, from the wheel-speed sensor over one period) and beyond target + jump_slip_margin is on
+  // a lower mu: the integral drops at once to the torque the tyre carries now (the wheel's torque
+  // balance R Fx = T_brake + I dw/dt), times jump_release_factor.
+  double jump_wheel_decel_m_s2 = 60.0;
+  double jump_slip_margin = 0.05;
+  double jump_release_factor = 0.8;
 };
 
 struct YawLimitParams {
@@ -69,6 +76,14 @@ struct YawLimitParams {
   // high side.
   double yaw_error_gain_Nm_per_rad_s = 8000.0;
   bool rear_select_low = true;
+  // A corner the CCU cannot use (lost, failed): its share of the driver's braking goes to the
+  // other axle's wheel on the same side (no yaw moment from the shift) and the front wheel it
+  // leaves alone on its axle may exceed it by the yaw moment the same-side rear wheel's extra
+  // torque balances plus lost_corner_initial_Nm + lost_corner_ramp_Nm_per_s t (less the
+  // yaw-rate feedback): a lost corner is a known, steady asymmetry, not a surface to probe.
+  bool redistribute_lost_corner = true;
+  double lost_corner_initial_Nm = 400.0;
+  double lost_corner_ramp_Nm_per_s = 3000.0;
 };
 
 struct BrakeControlParams {
