@@ -165,23 +165,48 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
     out_.yaw_limited = true;
   } else if (p_.abs_enabled && p_.yaw.enabled) {
     lost_s_ = 0.0;
-    const double lo = std::min(out_.torque_Nm[0], out_.torque_Nm[1]);
-    const double hi = std::max(out_.torque_Nm[0], out_.torque_Nm[1]);
-    const std::size_t low_side = out_.torque_Nm[0] <= out_.torque_Nm[1] ? 0 : 1;
+    // The torque a wheel's tyre carries at its estimated mu (while its slip controller acts).
+    auto capacity = [&](std::size_t w) {
+      return out_.wheels[w].active ? std::max(0.0, out_.wheels[w].mu_estimate) * std::max(100.0, load[w]) * c.wheel_radius_m : 0.0;
+    };
+    const std::size_t low_side = split_ ? low_side_ : (out_.torque_Nm[0] <= out_.torque_Nm[1] ? 0 : 1);
+    // The low side's reference: its command, but not below a share of what its tyre carries (a
+    // low-mu wheel's slip controller releasing for a moment must not take the high side down with it).
+    const double lo = std::max(out_.torque_Nm[low_side], p_.yaw.low_side_capacity_share * capacity(low_side));
+    const double hi = out_.torque_Nm[1 - low_side];
     const bool asym = (out_.wheels[low_side].active || !m.available[low_side]) && hi > 0.0 &&
                       lo < p_.yaw.asymmetry_ratio * hi && hi - lo > p_.yaw.min_difference_Nm;
     if (asym && !split_) {
       split_ = true;
       split_s_ = 0.0;
+      low_side_ = low_side;
+      // The heading and the reference count from here (tuning set: better than from brake onset).
+      heading_error_rad_ = 0.0;
+      brake_driver_yaw_rate_ = driver_yaw_rate;
     }
     if (split_) {
       split_s_ += dt_s;
       // Braking the right (left) side more turns the car right (left), yaw rate negative (positive).
-      const double towards_high = low_side == 0 ? -yaw_error : yaw_error;  // > 0: yawing towards the high side
+      // The reference: the yaw rate the driver steers for now, or (latch_driver_yaw_rate) the one
+      // steered for when the split was seen - a driver's counter-steer against the braking's
+      // moment is then no demand for yaw.
+      const double error = p_.yaw.latch_driver_yaw_rate ? m.yaw_rate_rad_s - brake_driver_yaw_rate_ : yaw_error;
+      const double towards_high = low_side == 0 ? -error : error;  // > 0: yawing towards the high side
+      // The heading turned towards the high side since the split was seen (beyond the yaw the
+      // driver steered for then).
+      // (The yaw-rate error integrated, never below 0.)
+      heading_error_rad_ = std::max(0.0, heading_error_rad_ + towards_high * dt_s);
+      const double heading_towards_high = heading_error_rad_;
       const double allowed = std::max(lo, lo + p_.yaw.initial_Nm + p_.yaw.ramp_Nm_per_s * split_s_ -
-                                              p_.yaw.yaw_error_gain_Nm_per_rad_s * std::max(0.0, towards_high));
+                                              p_.yaw.yaw_error_gain_Nm_per_rad_s * std::max(0.0, towards_high) -
+                                              p_.yaw.heading_error_gain_Nm_per_rad * heading_towards_high);
       out_.torque_Nm[1 - low_side] = std::min(out_.torque_Nm[1 - low_side], allowed);
-      if (p_.yaw.rear_select_low) out_.torque_Nm[2] = out_.torque_Nm[3] = std::min(out_.torque_Nm[2], out_.torque_Nm[3]);
+      if (p_.yaw.rear_select_low) {
+        const std::size_t rear_low = out_.torque_Nm[2] <= out_.torque_Nm[3] ? 2 : 3;
+        const double rear = std::max(out_.torque_Nm[rear_low], p_.yaw.low_side_capacity_share * capacity(rear_low));
+        out_.torque_Nm[2] = std::min(out_.torque_Nm[2], rear);
+        out_.torque_Nm[3] = std::min(out_.torque_Nm[3], rear);
+      }
     }
     if (z_request <= 0.0) split_ = false;
   }
@@ -189,6 +214,10 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
   if (lost >= 4 || !p_.yaw.redistribute_lost_corner) out_.yaw_limited = split_;
   for (std::size_t w = 0; w < 4; ++w) {
     out_.clamp_force_kN[w] = m.available[w] ? clamp_kN(w, out_.torque_Nm[w]) : 0.0;
+    // Under slip control the pads stay in contact: releasing through the air gap costs its
+    // closing time (about 45 ms) on every re-apply.
+    if (m.available[w] && out_.wheels[w].active && z_request > 0.0)
+      out_.clamp_force_kN[w] = std::max(out_.clamp_force_kN[w], p_.slip.active_min_clamp_kN);
   }
   return out_;
 }
