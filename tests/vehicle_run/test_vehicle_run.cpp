@@ -131,7 +131,9 @@ TEST(VehicleRun, ALostCornersBrakingGoesToTheOtherThree) {
   // measured with it (healthy 42.3 m). Regression bound on the measured figure; without the
   // redistribution the same run must be longer.
   auto s = vehicle_run::load_vehicle_scenario(scen("dry_fault_FL_lost_abs"));
-  vehicle_run::VehicleRun r(s, calibrator(), {});
+  vehicle_run::VehicleRunOptions o;
+  o.in_process.process_faults = true;  // the corner kill, as bbw_vehicle_inproc does
+  vehicle_run::VehicleRun r(s, calibrator(), o);
   r.run();
   const auto m = vehicle_run::vehicle_metrics(s, r);
   EXPECT_TRUE(m.stopped);
@@ -139,7 +141,7 @@ TEST(VehicleRun, ALostCornersBrakingGoesToTheOtherThree) {
   EXPECT_LT(m.max_lateral_deviation_m, 2.0);
   for (double l : m.longest_wheel_lock_s) EXPECT_LT(l, 0.1);
   s.brake.yaw.redistribute_lost_corner = false;
-  vehicle_run::VehicleRun off(s, calibrator(), {});
+  vehicle_run::VehicleRun off(s, calibrator(), o);
   off.run();
   EXPECT_GT(vehicle_run::vehicle_metrics(s, off).stopping_distance_m, m.stopping_distance_m + 3.0);
 }
