@@ -12,7 +12,6 @@ mkdir -p "$OUT"
 echo "| scenario | stop (m) | ideal (m) | ratio | epsilon | longest lock above 15 km/h (s) | max yaw rate (deg/s) | max lateral (m) | mean decel (g) | rtf |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
 for f in "$DIR"/*.yaml; do
-  case "$(basename "$f")" in sedan_tuning.yaml) continue;; esac
   name="$(basename "$f" .yaml)"
   "$BIN" "$f" --out "$OUT/$name" >/dev/null
   python3 - "$OUT/$name/summary.json" "$name" <<'PY'
