@@ -75,3 +75,74 @@ TEST(BrakeController, DistributesWithLoadTransferAndRefusesBadParams) {
   bad.slip.min_target_slip = 0.3;
   EXPECT_THROW(BrakeController{bad}, std::invalid_argument);
 }
+
+TEST(SlipController, AHighToLowMuJumpDropsTheIntegralToTheTyresTorqueAtOnce) {
+  // Under control at 10 % slip with 1400 N m; then the wheel falls away at 800 rad/s^2 (ice):
+  // the next period's torque is at most the tyre's present torque (1400 - 1.7 * 800 = 40 N m)
+  // times the release factor, not an integral running down over many periods.
+  SlipControlParams p;
+  SlipController c(p, 0.344, 1.7);
+  WheelInputs in;
+  in.ground_speed_m_s = 25.0;
+  in.wheel_rad_s = 0.9 * 25.0 / 0.344;
+  in.request_Nm = 2000.0;
+  in.applied_Nm = 1400.0;
+  in.load_N = 4000.0;
+  for (int i = 0; i < 40; ++i) c.update(0.005, in);
+  ASSERT_TRUE(c.last().active);
+  EXPECT_EQ(c.jump_releases(), 0u);
+  in.wheel_rad_s -= 800.0 * 0.005;
+  c.update(0.005, in);
+  EXPECT_EQ(c.jump_releases(), 1u);
+  EXPECT_LE(c.last().torque_Nm, p.jump_release_factor * (1400.0 - 1.7 * 800.0) + 1.0);
+  // Without the jump rule the same fall leaves the integral far higher for the next period.
+  SlipControlParams off = p;
+  off.jump_wheel_decel_m_s2 = 1e9;
+  off.kp_Nm_per_rad_s = 0.0;
+  p.kp_Nm_per_rad_s = 0.0;
+  SlipController a(p, 0.344, 1.7), b(off, 0.344, 1.7);
+  in.wheel_rad_s = 0.9 * 25.0 / 0.344;
+  for (int i = 0; i < 40; ++i) {
+    a.update(0.005, in);
+    b.update(0.005, in);
+  }
+  in.wheel_rad_s -= 800.0 * 0.005;
+  EXPECT_LT(a.update(0.005, in).torque_Nm + 500.0, b.update(0.005, in).torque_Nm);
+}
+
+namespace {
+BrakeOutput lost_corner_run(bool redistribute, std::size_t lost) {
+  BrakeControlParams p;
+  p.yaw.redistribute_lost_corner = redistribute;
+  BrakeController b(p);
+  BrakeMeasurements m;
+  for (double& w : m.wheel_rad_s) w = 20.0 / 0.344;  // rolling freely: no slip control
+  m.pedal_travel_mm = p.pedal.full_travel_mm * 0.3;
+  m.pedal_force_N = p.pedal.full_force_N * std::pow(0.3, p.pedal.force_exponent);
+  m.ax_m_s2 = -3.0;
+  m.available[lost] = false;
+  for (int i = 0; i < 200; ++i) b.update(0.005, m);
+  return b.last();
+}
+}  // namespace
+
+TEST(BrakeController, ALostCornersShareGoesToTheSameSideWheelOfTheOtherAxle) {
+  const BrakeOutput off = lost_corner_run(false, 0);
+  const BrakeOutput on = lost_corner_run(true, 0);
+  EXPECT_EQ(on.clamp_force_kN[0], 0.0);
+  const double total_off = off.torque_Nm[1] + off.torque_Nm[2] + off.torque_Nm[3];
+  const double total_on = on.torque_Nm[1] + on.torque_Nm[2] + on.torque_Nm[3];
+  EXPECT_GT(total_on, total_off + 100.0);
+  // RL takes FL's share; FR (no longer select-low / split-mu limited) keeps its own.
+  EXPECT_GT(on.torque_Nm[2], 2.0 * on.torque_Nm[3]);
+  EXPECT_TRUE(on.yaw_limited);
+  // The yaw moment left (front: FR alone; rear: RL over RR) stays within the limitation's bound.
+  const BrakeControlParams p;
+  const double moment_Nm = (on.torque_Nm[1] - on.torque_Nm[0]) * p.car.track_front_m +
+                           (on.torque_Nm[3] - on.torque_Nm[2]) * p.car.track_rear_m;  // x R / 2 both sides
+  EXPECT_LE(moment_Nm, 2.0 * (p.yaw.lost_corner_initial_Nm + p.yaw.lost_corner_ramp_Nm_per_s * 1.0) * p.car.track_front_m + 1.0);
+  // A lost rear corner: its share goes forward on the same side.
+  const BrakeOutput rear = lost_corner_run(true, 3);
+  EXPECT_EQ(rear.clamp_force_kN[3], 0.0);
+  EXPECT_GT(rear.torque_Nm[1], rear.torque_Nm[0]);
+}

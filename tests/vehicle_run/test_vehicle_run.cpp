@@ -126,6 +126,46 @@ TEST(VehicleRun, WithoutABSTheWheelsLock) {
   EXPECT_GT(longest, 0.5);
 }
 
+TEST(VehicleRun, ALostCornersBrakingGoesToTheOtherThree) {
+  // FL lost 0.5 s into an ABS stop (docs/vehicle.md): 67.2 m before the redistribution, 60.5 m
+  // measured with it (healthy 42.3 m). Regression bound on the measured figure; without the
+  // redistribution the same run must be longer.
+  auto s = vehicle_run::load_vehicle_scenario(scen("dry_fault_FL_lost_abs"));
+  vehicle_run::VehicleRunOptions o;
+  o.in_process.process_faults = true;  // the corner kill, as bbw_vehicle_inproc does
+  vehicle_run::VehicleRun r(s, calibrator(), o);
+  r.run();
+  const auto m = vehicle_run::vehicle_metrics(s, r);
+  EXPECT_TRUE(m.stopped);
+  EXPECT_LT(m.stopping_distance_m, 62.0);
+  EXPECT_LT(m.max_lateral_deviation_m, 2.0);
+  for (double l : m.longest_wheel_lock_s) EXPECT_LT(l, 0.1);
+  s.brake.yaw.redistribute_lost_corner = false;
+  vehicle_run::VehicleRun off(s, calibrator(), o);
+  off.run();
+  EXPECT_GT(vehicle_run::vehicle_metrics(s, off).stopping_distance_m, m.stopping_distance_m + 3.0);
+}
+
+TEST(VehicleRun, IceMeetsTheDistanceGoalAndSplitMuStaysWithinItsMeasuredBounds) {
+  // docs/vehicle.md, issue 15 second part (measured once, after tuning on the tuning set):
+  // ice ratio 1.051 (goal <= 1.10, met), epsilon 0.890 (goal 0.95 not met: regression bound);
+  // split-mu 95.44 m, lateral 1.23 m (goal 0.5 m not met: regression bounds).
+  auto ice = vehicle_run::load_vehicle_scenario(scen("ice_straight_100kmh"));
+  vehicle_run::VehicleRun a(ice, calibrator(), {});
+  a.run();
+  const auto mi = vehicle_run::vehicle_metrics(ice, a);
+  EXPECT_TRUE(mi.stopped);
+  EXPECT_LE(mi.distance_ratio, 1.10);
+  EXPECT_GE(mi.adhesion_utilisation, 0.85);
+  auto split = vehicle_run::load_vehicle_scenario(scen("split_mu_dry_ice_100kmh"));
+  vehicle_run::VehicleRun b(split, calibrator(), {});
+  b.run();
+  const auto ms = vehicle_run::vehicle_metrics(split, b);
+  EXPECT_TRUE(ms.stopped);
+  EXPECT_LT(ms.stopping_distance_m, 100.0);
+  EXPECT_LT(ms.max_lateral_deviation_m, 1.35);
+}
+
 TEST(VehicleRun, TheCaliperTemperatureComesFromTheDriving) {
   auto s = vehicle_run::load_vehicle_scenario(scen("dry_straight_100kmh"));
   s.disc_C = {400.0, 40.0, 40.0, 40.0};  // FL's disc hot: its caliper warms during the run

@@ -67,12 +67,23 @@ double BrakeController::torque_Nm(std::size_t w, double clamp) const {
   return 2.0 * p_.car.pad_mu * r * clamp * 1000.0;
 }
 
+std::size_t BrakeController::lost_corner(const BrakeMeasurements& m) {
+  std::size_t lost = 4, n = 0;
+  for (std::size_t w = 0; w < 4; ++w) {
+    if (!m.available[w]) {
+      lost = w;
+      ++n;
+    }
+  }
+  return n == 1 ? lost : 4;  // two or more lost: no redistribution (the yaw limitation alone)
+}
+
 const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements& m) {
   const CarModel& c = p_.car;
   const PedalDemand pd = pedal_demand(p_.pedal, m.pedal_travel_mm, m.pedal_force_N);
   if (pd.sensors_disagree) ++out_.pedal_disagreements;
   out_.demand = pd.demand;
-  const double z_request = pd.demand * p_.pedal.full_demand_g;
+  const double z_request = out_.demand * p_.pedal.full_demand_g;
   out_.decel_request_g = z_request;
   bool any_active = false;
   double held_slip = 1.0;
@@ -97,16 +108,27 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
                                    0.5 * front_axle_load + 0.55 * roll / c.track_front_m,
                                    0.5 * rear_axle_load - 0.45 * roll / c.track_rear_m,
                                    0.5 * rear_axle_load + 0.45 * roll / c.track_rear_m};
+  std::array<double, 4> request{};
   for (std::size_t w = 0; w < 4; ++w) {
     const double axle_force = total_N * (w < 2 ? front_share : 1.0 - front_share);
     // Share within the axle by load: the more loaded wheel carries more.
     const double axle_load = w < 2 ? front_axle_load : rear_axle_load;
     const double share = axle_load > 0.0 ? std::max(0.0, load[w]) / axle_load : 0.5;
+    request[w] = axle_force * share * c.wheel_radius_m;
+  }
+  // One corner lost: its share goes to the other axle's wheel on the same side (the shift makes
+  // no yaw moment; that wheel's slip controller keeps it within its grip).
+  const std::size_t lost = lost_corner(m);
+  if (p_.yaw.redistribute_lost_corner && lost < 4) {
+    request[lost ^ 2U] += request[lost];
+    request[lost] = 0.0;
+  }
+  for (std::size_t w = 0; w < 4; ++w) {
     WheelInputs in;
     in.wheel_rad_s = m.wheel_rad_s[w];
     const double half_track = 0.5 * (w < 2 ? c.track_front_m : c.track_rear_m);
     in.ground_speed_m_s = std::max(0.0, v + (w % 2 == 0 ? -1.0 : 1.0) * m.yaw_rate_rad_s * half_track);
-    in.request_Nm = axle_force * share * c.wheel_radius_m;
+    in.request_Nm = request[w];
     in.applied_Nm = torque_Nm(w, std::max(0.0, m.clamp_estimate_kN[w]));
     in.load_N = std::max(100.0, load[w]);
     if (!p_.abs_enabled) {
@@ -126,32 +148,76 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
   for (std::size_t w = 0; w < 4; ++w) {
     if (!m.available[w]) out_.torque_Nm[w] = 0.0;
   }
-  if (p_.abs_enabled && p_.yaw.enabled) {
-    const double lo = std::min(out_.torque_Nm[0], out_.torque_Nm[1]);
-    const double hi = std::max(out_.torque_Nm[0], out_.torque_Nm[1]);
-    const std::size_t low_side = out_.torque_Nm[0] <= out_.torque_Nm[1] ? 0 : 1;
+  const double driver_yaw_rate = v * m.steer_rad / (L + c.understeer_gradient_rad_s2_per_m * v * v);
+  const double yaw_error = m.yaw_rate_rad_s - driver_yaw_rate;  // > 0: yawing left more than steered
+  if (p_.abs_enabled && p_.yaw.enabled && p_.yaw.redistribute_lost_corner && lost < 4) {
+    // A lost corner: its axle partner may exceed it (0) by what the same-side wheel of the other
+    // axle balances (its extra torque over its axle partner, through the track ratio) plus a
+    // moment that builds up at lost_corner_ramp_Nm_per_s, less the yaw-rate feedback.
+    lost_s_ += dt_s;
+    const std::size_t partner = lost ^ 1U, same_side = lost ^ 2U, diagonal = lost ^ 3U;
+    const double track_ratio = lost < 2 ? c.track_rear_m / c.track_front_m : c.track_front_m / c.track_rear_m;
+    const double towards_partner = partner % 2 == 1 ? -yaw_error : yaw_error;
+    const double balanced = std::max(0.0, out_.torque_Nm[same_side] - out_.torque_Nm[diagonal]) * track_ratio;
+    const double allowed = std::max(0.0, balanced + p_.yaw.lost_corner_initial_Nm + p_.yaw.lost_corner_ramp_Nm_per_s * lost_s_ -
+                                             p_.yaw.yaw_error_gain_Nm_per_rad_s * std::max(0.0, towards_partner));
+    out_.torque_Nm[partner] = std::min(out_.torque_Nm[partner], allowed);
+    out_.yaw_limited = true;
+  } else if (p_.abs_enabled && p_.yaw.enabled) {
+    lost_s_ = 0.0;
+    // The torque a wheel's tyre carries at its estimated mu (while its slip controller acts).
+    auto capacity = [&](std::size_t w) {
+      return out_.wheels[w].active ? std::max(0.0, out_.wheels[w].mu_estimate) * std::max(100.0, load[w]) * c.wheel_radius_m : 0.0;
+    };
+    const std::size_t low_side = split_ ? low_side_ : (out_.torque_Nm[0] <= out_.torque_Nm[1] ? 0 : 1);
+    // The low side's reference: its command, but not below a share of what its tyre carries (a
+    // low-mu wheel's slip controller releasing for a moment must not take the high side down with it).
+    const double lo = std::max(out_.torque_Nm[low_side], p_.yaw.low_side_capacity_share * capacity(low_side));
+    const double hi = out_.torque_Nm[1 - low_side];
     const bool asym = (out_.wheels[low_side].active || !m.available[low_side]) && hi > 0.0 &&
                       lo < p_.yaw.asymmetry_ratio * hi && hi - lo > p_.yaw.min_difference_Nm;
     if (asym && !split_) {
       split_ = true;
       split_s_ = 0.0;
+      low_side_ = low_side;
+      // The heading and the reference count from here (tuning set: better than from brake onset).
+      heading_error_rad_ = 0.0;
+      brake_driver_yaw_rate_ = driver_yaw_rate;
     }
     if (split_) {
       split_s_ += dt_s;
       // Braking the right (left) side more turns the car right (left), yaw rate negative (positive).
-      const double driver_yaw_rate = v * m.steer_rad / (L + c.understeer_gradient_rad_s2_per_m * v * v);
-      const double yaw_error = m.yaw_rate_rad_s - driver_yaw_rate;
-      const double towards_high = low_side == 0 ? -yaw_error : yaw_error;  // > 0: yawing towards the high side
+      // The reference: the yaw rate the driver steers for now, or (latch_driver_yaw_rate) the one
+      // steered for when the split was seen - a driver's counter-steer against the braking's
+      // moment is then no demand for yaw.
+      const double error = p_.yaw.latch_driver_yaw_rate ? m.yaw_rate_rad_s - brake_driver_yaw_rate_ : yaw_error;
+      const double towards_high = low_side == 0 ? -error : error;  // > 0: yawing towards the high side
+      // The heading turned towards the high side since the split was seen (beyond the yaw the
+      // driver steered for then).
+      // (The yaw-rate error integrated, never below 0.)
+      heading_error_rad_ = std::max(0.0, heading_error_rad_ + towards_high * dt_s);
+      const double heading_towards_high = heading_error_rad_;
       const double allowed = std::max(lo, lo + p_.yaw.initial_Nm + p_.yaw.ramp_Nm_per_s * split_s_ -
-                                              p_.yaw.yaw_error_gain_Nm_per_rad_s * std::max(0.0, towards_high));
+                                              p_.yaw.yaw_error_gain_Nm_per_rad_s * std::max(0.0, towards_high) -
+                                              p_.yaw.heading_error_gain_Nm_per_rad * heading_towards_high);
       out_.torque_Nm[1 - low_side] = std::min(out_.torque_Nm[1 - low_side], allowed);
-      if (p_.yaw.rear_select_low) out_.torque_Nm[2] = out_.torque_Nm[3] = std::min(out_.torque_Nm[2], out_.torque_Nm[3]);
+      if (p_.yaw.rear_select_low) {
+        const std::size_t rear_low = out_.torque_Nm[2] <= out_.torque_Nm[3] ? 2 : 3;
+        const double rear = std::max(out_.torque_Nm[rear_low], p_.yaw.low_side_capacity_share * capacity(rear_low));
+        out_.torque_Nm[2] = std::min(out_.torque_Nm[2], rear);
+        out_.torque_Nm[3] = std::min(out_.torque_Nm[3], rear);
+      }
     }
     if (z_request <= 0.0) split_ = false;
   }
   out_.split_mu = split_;
+  if (lost >= 4 || !p_.yaw.redistribute_lost_corner) out_.yaw_limited = split_;
   for (std::size_t w = 0; w < 4; ++w) {
     out_.clamp_force_kN[w] = m.available[w] ? clamp_kN(w, out_.torque_Nm[w]) : 0.0;
+    // Under slip control the pads stay in contact: releasing through the air gap costs its
+    // closing time (about 45 ms) on every re-apply.
+    if (m.available[w] && out_.wheels[w].active && z_request > 0.0)
+      out_.clamp_force_kN[w] = std::max(out_.clamp_force_kN[w], p_.slip.active_min_clamp_kN);
   }
   return out_;
 }

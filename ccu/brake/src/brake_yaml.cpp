@@ -62,6 +62,10 @@ BrakeControlParams read_brake_control(Reader& r) {
     p.slip.dither_settle_s = c.number("dither_settle_s", Range::non_negative());
     p.slip.search_step = c.number("search_step", Range::closed(0, 0.1));
     p.slip.search_threshold_mu = c.number("search_threshold_mu", Range::non_negative());
+    p.slip.jump_wheel_decel_m_s2 = c.number("jump_wheel_decel_m_s2", Range::positive());
+    p.slip.jump_slip_margin = c.number("jump_slip_margin", Range::closed(0, 0.5));
+    p.slip.jump_release_factor = c.number("jump_release_factor", Range::closed(0, 1));
+    p.slip.active_min_clamp_kN = c.number("active_min_clamp_kN", Range::closed(0, 5));
     c.finish();
   }
   {
@@ -72,7 +76,13 @@ BrakeControlParams read_brake_control(Reader& r) {
     p.yaw.ramp_Nm_per_s = c.number("ramp_Nm_per_s", Range::positive());
     p.yaw.initial_Nm = c.number("initial_Nm", Range::non_negative());
     p.yaw.yaw_error_gain_Nm_per_rad_s = c.number("yaw_error_gain_Nm_per_rad_s", Range::non_negative());
+    p.yaw.heading_error_gain_Nm_per_rad = c.number("heading_error_gain_Nm_per_rad", Range::non_negative());
+    p.yaw.latch_driver_yaw_rate = c.boolean("latch_driver_yaw_rate");
     p.yaw.rear_select_low = c.boolean("rear_select_low");
+    p.yaw.low_side_capacity_share = c.number("low_side_capacity_share", Range::closed(0, 1));
+    p.yaw.redistribute_lost_corner = c.boolean("redistribute_lost_corner");
+    p.yaw.lost_corner_initial_Nm = c.number("lost_corner_initial_Nm", Range::non_negative());
+    p.yaw.lost_corner_ramp_Nm_per_s = c.number("lost_corner_ramp_Nm_per_s", Range::positive());
     c.finish();
   }
   r.finish();

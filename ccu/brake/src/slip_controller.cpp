@@ -79,6 +79,14 @@ const WheelDecision& SlipController::update(double dt_s, const WheelInputs& in) 
       return d_;
     }
   }
+  // High-to-low mu jump: the wheel falls away faster than any braking on the old surface could
+  // make it; drop the integral at once to what the tyre carries now instead of integrating down.
+  const bool falling = -w_dot_raw * radius_m_ > p_.jump_wheel_decel_m_s2 && d_.slip > target + p_.jump_slip_margin;
+  if (falling) {
+    const double tyre_Nm = std::max(0.0, in.applied_Nm + inertia_kg_m2_ * w_dot_raw);
+    integral_Nm_ = std::min(integral_Nm_, p_.jump_release_factor * tyre_Nm);
+    ++jumps_;
+  }
   integral_Nm_ = std::clamp(integral_Nm_ + p_.ki_Nm_per_rad * err * dt_s, 0.0, request);
   const double torque = std::clamp(integral_Nm_ + p_.kp_Nm_per_rad_s * err, 0.0, request);
   d_.torque_Nm = torque;

@@ -43,6 +43,7 @@ struct BrakeOutput {
   double decel_request_g = 0.0;
   double speed_estimate_m_s = 0.0;
   bool split_mu = false;
+  bool yaw_limited = false;      // split-mu or a lost corner's yaw limitation acts
   std::uint64_t pedal_disagreements = 0;
 };
 
@@ -61,8 +62,13 @@ class BrakeController {
   SpeedEstimator speed_;
   std::array<SlipController, 4> slip_;
   double ax_filt_ = 0.0;
+  static std::size_t lost_corner(const BrakeMeasurements& m);  // the one unavailable corner, else 4
   double split_s_ = 0.0;        // time since split-mu was detected
+  double lost_s_ = 0.0;         // time since a lost corner's yaw limitation began
   bool split_ = false;
+  double heading_error_rad_ = 0.0;
+  double brake_driver_yaw_rate_ = 0.0;  // the driver's yaw rate when the split was seen  // yaw-rate error integrated while split_
+  std::size_t low_side_ = 0;    // the front wheel on the low mu, latched while split_
   BrakeOutput out_;
 };
 

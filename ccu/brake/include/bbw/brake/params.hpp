@@ -56,6 +56,15 @@ struct SlipControlParams {
   double dither_settle_s = 0.08;
   double search_step = 0.01;
   double search_threshold_mu = 0.005;
+  // High-to-low mu jump: under control, a wheel decelerating faster than this (m/s^2 at the
+  // rim, from the wheel-speed sensor over one period) and beyond target + jump_slip_margin is on
+  // a lower mu: the integral drops at once to the torque the tyre carries now (the wheel's torque
+  // balance R Fx = T_brake + I dw/dt), times jump_release_factor.
+  double jump_wheel_decel_m_s2 = 60.0;
+  double jump_slip_margin = 0.05;
+  double jump_release_factor = 0.8;
+  // Clamp force kept while the slip controller acts (the pads stay on the disc).
+  double active_min_clamp_kN = 0.3;
 };
 
 struct YawLimitParams {
@@ -68,7 +77,22 @@ struct YawLimitParams {
   // steers for (the steering-angle sensor through the single-track model) takes torque off the
   // high side.
   double yaw_error_gain_Nm_per_rad_s = 8000.0;
+  // ... and the heading error (that yaw-rate error integrated since the brake was applied).
+  double heading_error_gain_Nm_per_rad = 0.0;
+  // Reference yaw rate latched when the split is seen (true) or the driver's steering now (false).
+  bool latch_driver_yaw_rate = false;
   bool rear_select_low = true;
+  // The low side's reference is its command but not below this share of the torque its tyre
+  // carries at the estimated mu (front and, for select-low, rear).
+  double low_side_capacity_share = 0.8;
+  // A corner the CCU cannot use (lost, failed): its share of the driver's braking goes to the
+  // other axle's wheel on the same side (no yaw moment from the shift) and the front wheel it
+  // leaves alone on its axle may exceed it by the yaw moment the same-side rear wheel's extra
+  // torque balances plus lost_corner_initial_Nm + lost_corner_ramp_Nm_per_s t (less the
+  // yaw-rate feedback): a lost corner is a known, steady asymmetry, not a surface to probe.
+  bool redistribute_lost_corner = true;
+  double lost_corner_initial_Nm = 400.0;
+  double lost_corner_ramp_Nm_per_s = 3000.0;
 };
 
 struct BrakeControlParams {

@@ -32,6 +32,7 @@ class SlipController {
   const WheelDecision& update(double dt_s, const WheelInputs& in);
   const WheelDecision& last() const { return d_; }
   double target_slip() const { return target_; }
+  unsigned long jump_releases() const { return jumps_; }  // high-to-low mu jumps released
 
  private:
   void search(double dt_s, double slip);
@@ -49,6 +50,7 @@ class SlipController {
   int count_ = 0;
   double mean_plus_ = 0.0, mean_minus_ = 0.0;
   bool have_plus_ = false, have_minus_ = false;
+  unsigned long jumps_ = 0;
   WheelDecision d_;
 };
 
