@@ -40,6 +40,33 @@ TEST(FaultScorer, OnlyTheRightFindingOnItsCornerWithinTheWindowDetects) {
   EXPECT_TRUE(clean.false_alarms.empty());
 }
 
+// A killed corner restarted 0.5 s later: lost link first (within 0.1 s), then named a process
+// loss when its new incarnation joins, which on a loaded machine can be 0.2 s or more after the
+// restart; the naming is explained up to the participant lease (2 s), not only up to the
+// restart plus the 0.1 s window (SystemFaultsRealtime.ARestartedCornerIsNamedAsAProcessLossAndRejoins
+// failed when the new process joined after 1.6 s).
+TEST(FaultScorer, ARestartedProcessIsNamedUpToTheLeaseAfterItsKill) {
+  FaultSpec kill = fault(Target::RR, Part::Process, FaultType::Kill, 1.0);
+  kill.restart_after_s = 0.5;
+  const std::vector<DetectionEvent> d{{Target::RR, Finding::LinkLost, 1.0, 1.01},
+                                      {Target::RR, Finding::ProcessLost, 1.0, 1.72}};
+  const RunScore s = score_run({kill}, d);
+  ASSERT_EQ(s.outcomes.size(), 1u);
+  EXPECT_TRUE(s.outcomes[0].detected);
+  EXPECT_TRUE(s.outcomes[0].correct);
+  EXPECT_EQ(s.outcomes[0].diagnosis, Finding::ProcessLost);
+  EXPECT_DOUBLE_EQ(s.outcomes[0].diagnosis_s, 1.72);  // the process named when its new incarnation joined
+  EXPECT_DOUBLE_EQ(s.outcomes[0].detected_s, 1.01);   // the loss found as a lost link
+  EXPECT_TRUE(s.false_alarms.empty());
+  // Beyond the lease it is no longer this kill's naming: a false alarm.
+  const RunScore late = score_run({kill}, {d[0], {Target::RR, Finding::ProcessLost, 1.0, 3.2}});
+  EXPECT_EQ(late.outcomes[0].diagnosis, Finding::LinkLost);
+  ASSERT_EQ(late.false_alarms.size(), 1u);
+  // A link_lost long after the restart is not explained by the kill either.
+  const RunScore link = score_run({kill}, {d[0], {Target::RR, Finding::LinkLost, 1.0, 1.9}});
+  EXPECT_EQ(link.false_alarms.size(), 1u);
+}
+
 TEST(FaultScorer, ALateRightFindingIsAMissButNoFalseAlarm) {
   const FaultSpec f = fault(Target::FL, Part::LoadCell, FaultType::Bias, 1.0);
   ASSERT_DOUBLE_EQ(detection_window_s(f), 0.5);

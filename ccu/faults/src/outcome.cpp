@@ -97,9 +97,16 @@ bool right_finding(const FaultSpec& f, Finding d) {
 
 namespace {
 
+// The participants' discovery lease (config/dds/bbw_profiles.xml, leaseDuration 2 s): a killed
+// process is named (process_lost) by the lease running out, or earlier by its restarted
+// incarnation's first samples, which may come well after the restart (its discovery).
+constexpr double kParticipantLease_s = 2.0;
+
 bool explains(const FaultSpec& f, const DetectionEvent& d) {
   if (f.target != d.corner || !right_finding(f, d.finding) || d.detected_s < f.at_s - 1e-9) return false;
-  const double end_s = f.type == FaultType::Kill && !f.restart_after_s ? std::numeric_limits<double>::infinity() : f.end_s();
+  double end_s = f.type == FaultType::Kill && !f.restart_after_s ? std::numeric_limits<double>::infinity() : f.end_s();
+  // A restarted process is named at the latest when the lease of the killed one runs out.
+  if (f.type == FaultType::Kill && d.finding == Finding::ProcessLost) end_s = std::max(end_s, f.at_s + kParticipantLease_s);
   return d.detected_s <= end_s + detection_window_s(f) + 1e-9;
 }
 
