@@ -34,7 +34,7 @@ faults::CornerReading reading_from(const msg::MeasurementSample& s) {
   r.time_s = s.time_s();
   r.position_rev = s.position_rev();
   r.speed_rev_per_s = s.speed_rev_per_s();
-  r.load_cell_kN = s.force_internal_kN();
+  r.force_kN = s.force_internal_kN();
   r.motor_current_A = s.motor_current_A();
   r.temperature_C = s.temperature_C();
   r.force_command_kN = (s.status() & msg::STATUS_FORCE_MODE) ? s.command() : std::nan("");

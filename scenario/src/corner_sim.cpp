@@ -118,15 +118,10 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
   const plant::Measurement& y = readings_;
   const plant::PlantState& s = plant_.state();
   time_s_ = t_next;
+  static_cast<plant::Measurement&>(sample_) = y;
   sample_.seq = ++seq_;
-  sample_.time_s = time_s_;
-  sample_.position_rev = y.position_rev;
-  sample_.speed_rev_per_s = y.speed_rev_per_s;
-  sample_.force_internal_kN = y.force_internal_kN;
-  sample_.force_external_kN = y.force_external_kN;
+  sample_.time_s = time_s_;  // the corner's clock (the plant's is the same sum of steps)
   sample_.force_true_kN = s.force_true_kN;
-  sample_.temperature_C = y.temperature_C;
-  sample_.motor_current_A = y.motor_current_A;
   sample_.friction_true_kN = s.friction_kN;
   sample_.position_true_rev = s.position_rev;
   return sample_;

@@ -18,7 +18,7 @@ CornerReading at(std::uint64_t seq, double t, double x = 2.0, double lc = 5.0) {
   r.seq = seq;
   r.time_s = t;
   r.position_rev = x;
-  r.load_cell_kN = lc;
+  r.force_kN = lc;
   r.motor_current_A = 1.0;
   return r;
 }

@@ -110,7 +110,7 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
     // ends now is not fitted, so the fault is not learnt as the curve (it was: a -1 kN bias at
     // a turning point moved the curve by 0.75 kN and was never found).
     calibrator_->hold_fits(monitor_.residual_suspect());
-    e = calibrator_->update(calibration::Sample{r.time_s, r.position_rev, r.load_cell_kN, r.speed_rev_per_s, r.temperature_C});
+    e = calibrator_->update(r);  // a CornerReading is the calibrator's Sample and more
     const double dt_s = std::isfinite(last_fed_time_s_) ? r.time_s - last_fed_time_s_ : 0.0;
     fused_kN_ = fusion_.update(e, dt_s);
     if (e.valid) last_fed_time_s_ = r.time_s;
@@ -161,12 +161,12 @@ void CornerSupervisor::refresh_view(const CornerReading* r, const SampleCheck* c
       const double hw = monitor_.params().eol_friction_half_width_kN;
       if (std::isfinite(load_filtered_kN_)) {
         const double prev = load_filtered_kN_;
-        load_filtered_kN_ += (r->load_cell_kN - load_filtered_kN_) * kLoadFilterGain;
+        load_filtered_kN_ += (r->force_kN - load_filtered_kN_) * kLoadFilterGain;
         load_friction_kN_ = std::clamp(load_friction_kN_ + kFrictionShare * (load_filtered_kN_ - prev), -hw, hw);
       } else {
-        load_filtered_kN_ = r->load_cell_kN;
+        load_filtered_kN_ = r->force_kN;
       }
-      view_.force_estimate_kN = std::max(0.0, r->load_cell_kN - load_friction_kN_);
+      view_.force_estimate_kN = std::max(0.0, r->force_kN - load_friction_kN_);
       view_.source = EstimateSource::LoadCell;
     } else {
       view_.force_estimate_kN = std::numeric_limits<double>::quiet_NaN();

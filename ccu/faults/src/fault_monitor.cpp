@@ -140,7 +140,7 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   jump_.update(c, p_, arbiter_);
   stuck_.update(c, p_, arbiter_);
   if (estimate != nullptr && estimate->valid) residual_.update(r, *estimate, p_, arbiter_, noise_, stuck_, jump_);
-  const double load_kN = check.load_cell_present && arbiter_.ok(Part::LoadCell) ? r.load_cell_kN : force_estimate_kN;
+  const double load_kN = check.load_cell_present && arbiter_.ok(Part::LoadCell) ? r.force_kN : force_estimate_kN;
   torque_.update(c, load_kN, p_, arbiter_);
   tracking_.update(c, force_estimate_kN, p_, arbiter_);
 

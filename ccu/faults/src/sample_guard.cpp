@@ -54,15 +54,15 @@ void SampleGuard::rejoin() { seq_continuity_ = false; }
 
 SampleCheck SampleGuard::check(const CornerReading& r) {
   SampleCheck c;
-  const bool lc_nan = std::isnan(r.load_cell_kN);
+  const bool lc_nan = std::isnan(r.force_kN);
   const bool cmd_ok = std::isnan(r.force_command_kN) || std::isfinite(r.force_command_kN);
   if (!std::isfinite(r.time_s) || !std::isfinite(r.position_rev) || !std::isfinite(r.speed_rev_per_s) ||
-      !std::isfinite(r.motor_current_A) || (!lc_nan && !std::isfinite(r.load_cell_kN)) || !cmd_ok) {
+      !std::isfinite(r.motor_current_A) || (!lc_nan && !std::isfinite(r.force_kN)) || !cmd_ok) {
     c.issue = SampleIssue::NonFinite;
   } else if (r.position_rev < limits_.position_min_rev || r.position_rev > limits_.position_max_rev ||
              std::abs(r.speed_rev_per_s) > limits_.speed_abs_max_rev_per_s ||
              std::abs(r.motor_current_A) > limits_.current_abs_max_A ||
-             (!lc_nan && (r.load_cell_kN < limits_.load_cell_min_kN || r.load_cell_kN > limits_.load_cell_max_kN))) {
+             (!lc_nan && (r.force_kN < limits_.load_cell_min_kN || r.force_kN > limits_.load_cell_max_kN))) {
     c.issue = SampleIssue::OutOfRange;
   } else if (have_last_ && seq_continuity_ && r.seq == last_seq_) {
     c.issue = SampleIssue::Duplicate;

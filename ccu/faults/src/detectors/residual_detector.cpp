@@ -41,7 +41,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     // The end-of-line curve at the measured temperature, with its band.
     const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
     const double eol_kN = eol_->force_kN(r.position_rev, temperature_C, 0.0);
-    residual_kN_ = r.load_cell_kN - eol_kN;
+    residual_kN_ = r.force_kN - eol_kN;
     thr = p.eol_friction_half_width_kN + p.eol_band_kN + p.eol_relative * std::abs(eol_kN) +
           p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s);
     if (!eol_mode_) have_reference_ = false;

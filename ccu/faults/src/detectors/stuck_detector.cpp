@@ -12,7 +12,7 @@ void StuckDetector::update(const SampleContext& c, const MonitorParams& p, Diagn
   const CornerReading& prev = c.prev;
   const double t = r.time_s;
   // Stuck load cell: the same value again while the position travels.
-  if (c.check.load_cell_present && c.prev_load_cell_present && r.load_cell_kN == prev.load_cell_kN) {
+  if (c.check.load_cell_present && c.prev_load_cell_present && r.force_kN == prev.force_kN) {
     if (lc_repeat_ == 0) {
       lc_run_onset_s_ = prev.time_s;
       run_pos_min_ = run_pos_max_ = prev.position_rev;
@@ -30,11 +30,11 @@ void StuckDetector::update(const SampleContext& c, const MonitorParams& p, Diagn
   if (r.position_rev == prev.position_rev && c.check.load_cell_present) {
     if (pos_repeat_ == 0) {
       pos_run_onset_s_ = prev.time_s;
-      run_lc_min_ = run_lc_max_ = r.load_cell_kN;
+      run_lc_min_ = run_lc_max_ = r.force_kN;
     }
     ++pos_repeat_;
-    run_lc_min_ = std::min(run_lc_min_, r.load_cell_kN);
-    run_lc_max_ = std::max(run_lc_max_, r.load_cell_kN);
+    run_lc_min_ = std::min(run_lc_min_, r.force_kN);
+    run_lc_max_ = std::max(run_lc_max_, r.force_kN);
     if (pos_repeat_ >= p.stuck_samples && run_lc_max_ - run_lc_min_ >= p.stuck_min_force_change_kN) {
       a.confirm(Finding::ResolverStuck, pos_run_onset_s_, t);
     }

@@ -18,18 +18,14 @@ namespace bbw::scenario {
 
 enum class CommandKind { Position, Force };
 
-// One measurement sample. Fields measured by sensors come first; *_true fields are the
-// simulation's ground truth (not available to a real corner).
-struct CornerSample {
+// One sample of a corner: the plant's sensor readings (plant::Measurement: time, resolver
+// position and speed, load cell, external force, temperature, motor current; the one shape of
+// a sensor reading on the corner's side of the wire, after any fault injection) plus what the
+// corner adds: its sequence number, the local loop's command, and the simulation's ground truth
+// (*_true fields, not available to a real corner).
+struct CornerSample : plant::Measurement {
   std::uint64_t seq = 0;            // 1 for the first step
-  double time_s = 0.0;
-  double position_rev = 0.0;        // resolver
-  double speed_rev_per_s = 0.0;         // resolver speed
-  double force_internal_kN = 0.0;   // load cell
-  double force_external_kN = 0.0;   // external (test rig) force sensor
   double force_true_kN = 0.0;       // truth
-  double temperature_C = 0.0;       // temperature sensor
-  double motor_current_A = 0.0;     // current sensor
   CommandKind command_kind = CommandKind::Position;
   double command = 0.0;             // position_rev or force_kN, per command_kind
   double current_command_A = 0.0;
