@@ -2,6 +2,7 @@
 // runs that cannot collide, corners that refuse unsafe commands, stops that keep their results.
 // Domains 200-211, one per test (noted per test); runs that share a domain do so on purpose.
 // Every process is bounded (launcher wall-time bound, waits with deadlines); nothing sleeps.
+#include <algorithm>
 #include <gtest/gtest.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -404,6 +405,18 @@ TEST(SystemStops, AReusedOutputDirectoryIsClearedOrRefused) {
   EXPECT_FALSE(fs::exists(out + "/corner_FL.1.stats")) << "an older run's file survived beside the new one";
   EXPECT_EQ(slurp(out + "/summary.json").find("older"), std::string::npos);
   EXPECT_NE(l.out().find("files of an older run"), std::string::npos) << l.out();
+
+  // A run with its report (report.html, report.gp, report.gp.log, PNGs) into the same folder,
+  // twice: every file a run writes is its own, so the second replaces the first (`./bbw demo`
+  // twice once failed on report.gp.log).
+  for (const char* name : {"with_report_1", "with_report_2"}) {
+    auto argv = launch_argv("tests/system/data/short_stop.yaml", out, "lockstep", 209);
+    argv.erase(std::find(argv.begin(), argv.end(), std::string("--no-report")));
+    Launch r(dir, name, argv);
+    const auto st_r = r.wait(150s);
+    ASSERT_TRUE(st_r.ok()) << describe(st_r, r);
+    EXPECT_TRUE(fs::exists(out + "/report.html")) << name;
+  }
 
   std::ofstream(out + "/notes.txt") << "mine\n";
   Launch refused(dir, "second", launch_argv("tests/system/data/short_stop.yaml", out, "lockstep", 209));

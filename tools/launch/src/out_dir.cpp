@@ -11,7 +11,7 @@ namespace fs = std::filesystem;
 
 bool is_run_output_name(const std::string& name) {
   static const std::regex own(
-      "summary\\.json|report\\.html|report\\.gp|timeline\\.csv|timeline\\.png|keys\\.(out|err)|"
+      "summary\\.json|report\\.html|report\\.gp(\\.log)?|timeline\\.csv|timeline\\.png|keys\\.(out|err)|"
       "ccu\\.(out|err|stats)|ccu_periods\\.csv|ccu_(FL|FR|RL|RR)\\.csv|(loop|time)_(FL|FR|RL|RR)\\.png|"
       "corner_(FL|FR|RL|RR)(\\.[0-9]+)?\\.(out|err|stats)|corner_(FL|FR|RL|RR)_periods\\.csv|"
       // A vehicle run (issue 15): bbw_vehicle's and bbw_pedal's outputs and plots.
