@@ -139,8 +139,8 @@ int main(int argc, char** argv) {
               << scenario->name << ", " << scenario->corners.size() << " corners" << std::endl;
     rc = app.run(error);
     if (!opt.out_dir.empty()) app.write_stats(opt.out_dir + "/ccu.stats");
-    // A standby run: the results are written; Fast DDS's teardown gets 5 s (teardown_guard.hpp).
-    if (opt.standby) bbw::runtime::bound_teardown("bbw_ccu", std::chrono::milliseconds(5000), rc);
+    // The results are written; Fast DDS's teardown gets 5 s (teardown_guard.hpp).
+    bbw::runtime::bound_teardown("bbw_ccu", std::chrono::milliseconds(5000), rc);
   } catch (const std::invalid_argument& e) {
     std::cerr << "bbw_ccu: " << e.what() << "\n";
     return kExitUsage;

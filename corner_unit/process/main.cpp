@@ -153,8 +153,8 @@ int main(int argc, char** argv) {
     if (!opt.stats_file.empty()) app->write_stats(opt.stats_file);
     std::cout << "bbw_corner " << corner_arg << ": " << app->stats().periods << " periods, "
               << app->stats().samples_published << " samples published" << std::endl;
-    // A standby run: the results are written; Fast DDS's teardown gets 5 s (teardown_guard.hpp).
-    if (opt.standby) bbw::runtime::bound_teardown("bbw_corner " + corner_arg, std::chrono::milliseconds(5000), rc);
+    // The results are written; Fast DDS's teardown gets 5 s (teardown_guard.hpp).
+    bbw::runtime::bound_teardown("bbw_corner " + corner_arg, std::chrono::milliseconds(5000), rc);
   } catch (const std::invalid_argument& e) {
     std::cerr << "bbw_corner " << corner_arg << ": " << e.what() << "\n";
     return kExitUsage;
