@@ -120,6 +120,21 @@ inline std::string fastdds_pdp_abort(const std::string& out_dir) {
   return "";
 }
 
+// One `"key": value` line of summary.json (our writer: one member per line): the key and the
+// value, a string's quotes and the trailing comma removed. False when the line is no member.
+inline bool member_line(const std::string& line, std::string& key, std::string& value) {
+  const auto q1 = line.find('"');
+  const auto q2 = line.find('"', q1 + 1);
+  const auto colon = line.find(':', q2);
+  if (q1 == std::string::npos || q2 == std::string::npos || colon == std::string::npos) return false;
+  value = line.substr(colon + 1);
+  value.erase(0, value.find_first_not_of(' '));
+  while (!value.empty() && (value.back() == ',' || value.back() == ' ')) value.pop_back();
+  if (value.size() >= 2 && value.front() == '"') value = value.substr(1, value.size() - 2);
+  key = line.substr(q1 + 1, q2 - q1 - 1);
+  return true;
+}
+
 // The objects of the array `array` in summary.json ("faults", "detections", "corners"): one map
 // per object, string values unquoted. summary.json is written by our own writer, one key per line.
 inline std::vector<std::map<std::string, std::string>> objects(const std::string& json, const std::string& array) {
@@ -136,15 +151,8 @@ inline std::vector<std::map<std::string, std::string>> objects(const std::string
     std::istringstream lines(json.substr(open + 1, close - open - 1));
     std::string line;
     while (std::getline(lines, line)) {
-      const auto q1 = line.find('"');
-      const auto q2 = line.find('"', q1 + 1);
-      const auto colon = line.find(':', q2);
-      if (q1 == std::string::npos || q2 == std::string::npos || colon == std::string::npos) continue;
-      std::string v = line.substr(colon + 1);
-      v.erase(0, v.find_first_not_of(' '));
-      while (!v.empty() && (v.back() == ',' || v.back() == ' ')) v.pop_back();
-      if (v.size() >= 2 && v.front() == '"') v = v.substr(1, v.size() - 2);
-      m[line.substr(q1 + 1, q2 - q1 - 1)] = v;
+      std::string k, v;
+      if (member_line(line, k, v)) m[k] = v;
     }
     out.push_back(m);
     pos = close + 1;

@@ -44,15 +44,8 @@ std::map<std::string, std::string> object(const std::string& json, const std::st
   std::string line;
   std::getline(lines, line);  // "key": {
   while (std::getline(lines, line)) {
-    const auto q1 = line.find('"');
-    const auto q2 = line.find('"', q1 + 1);
-    const auto colon = line.find(':', q2);
-    if (q1 == std::string::npos || q2 == std::string::npos || colon == std::string::npos) continue;
-    std::string v = line.substr(colon + 1);
-    v.erase(0, v.find_first_not_of(' '));
-    while (!v.empty() && (v.back() == ',' || v.back() == ' ')) v.pop_back();
-    if (v.size() >= 2 && v.front() == '"') v = v.substr(1, v.size() - 2);
-    m[line.substr(q1 + 1, q2 - q1 - 1)] = v;
+    std::string k, v;
+    if (member_line(line, k, v)) m[k] = v;
   }
   return m;
 }
