@@ -219,6 +219,10 @@ Scenario read_scenario(Reader& r, const ExtraKeys& extra) {
   s.seed = static_cast<std::uint64_t>(r.integer("seed", 0, std::numeric_limits<std::int64_t>::max()));
   s.duration_s = r.number("duration_s", Range{0.0, 1.0e5, true, false});
   s.duration_line = line_of(r.node()["duration_s"]);
+  if (r.has("processes")) {
+    s.processes_line = line_of(r.node()["processes"]);
+    s.processes = r.strings("processes");
+  }
   s.plant_dt_s = r.number_or("plant_dt_s", 0.001, Range::closed(1.0e-5, 0.01));
   s.ccu_period_s = r.number_or("ccu_period_s", 0.005, Range::closed(1.0e-4, 1.0));
   if (s.ccu_period_s < s.plant_dt_s) r.fail("ccu_period_s", "must be >= plant_dt_s");

@@ -202,3 +202,49 @@ TEST(DelayQueue, ReleasesInOrderWhenDueAndRefusesWhenFull) {
   EXPECT_EQ(*q.pop_due(0.05), 3);
   EXPECT_EQ(q.size(), 0u);
 }
+
+// A scenario declares the processes ./bbw run starts (issue 12): ccu, ccu_standby with a standby,
+// each of its corners; what it leaves out or adds is refused with the file, line, key and rule.
+TEST(FaultSchedule, DeclaredProcessesAreTheScenariosCornersAndCcus) {
+  const auto declared = parse("processes: [ccu, FL, RR]\n");
+  EXPECT_EQ(declared.scenario.processes, (std::vector<std::string>{"ccu", "FL", "RR"}));
+  EXPECT_EQ(declared.scenario.processes_line, 9);
+  EXPECT_EQ(run_processes(declared.scenario.processes, {"FL", "RR"}, declared.faults),
+            (std::vector<std::string>{"ccu", "FL", "RR"}));
+  const auto plain = parse("");
+  EXPECT_TRUE(plain.scenario.processes.empty());
+  EXPECT_EQ(run_processes({}, {"FL", "RR"}, plain.faults), (std::vector<std::string>{"ccu", "FL", "RR"}));
+  const auto standby = parse("standby: true\nprocesses: [ccu, ccu_standby, FL, RR]\n");
+  EXPECT_EQ(run_processes({}, {"FL", "RR"}, standby.faults), (std::vector<std::string>{"ccu", "ccu_standby", "FL", "RR"}));
+
+  EXPECT_EQ(key_of_error("processes: [ccu, FL]\n"),
+            "processes | corner RR of this scenario has no process: list it (each corner runs as one)");
+  EXPECT_EQ(key_of_error("processes: [ccu, FL, RR, FR]\n"), "processes | no corner named FR in this scenario");
+  EXPECT_EQ(key_of_error("processes: [FL, RR]\n"), "processes | a run needs its CCU: list ccu");
+  EXPECT_EQ(key_of_error("processes: [ccu, FL, RR, FL]\n"), "processes | 'FL' is listed twice");
+  EXPECT_EQ(key_of_error("processes: [ccu, FL, RR, pedal]\n"),
+            "processes | 'pedal' runs in a vehicle scenario only (config/scenarios/vehicle/)");
+  EXPECT_EQ(key_of_error("processes: [ccu, FL, RR, gateway]\n"),
+            "processes | unknown process 'gateway' (ccu, ccu_standby, FL, FR, RL, RR)");
+  EXPECT_EQ(key_of_error("processes: [ccu, ccu_standby, FL, RR]\n"), "processes | ccu_standby needs standby: true (a hot-standby run)");
+  EXPECT_EQ(key_of_error("standby: true\nprocesses: [ccu, FL, RR]\n"),
+            "processes | standby: true runs a hot-standby CCU: list ccu_standby");
+  EXPECT_NE(key_of_error("processes: ccu\n").find("processes | must be a non-empty list of strings"), std::string::npos);
+  EXPECT_NE(key_of_error("processes: []\n").find("processes | must be a non-empty list of strings"), std::string::npos);
+}
+
+// Every shipped four-corner scenario declares its processes, and they are what it runs.
+TEST(FaultSchedule, EveryShippedRunScenarioDeclaresItsProcesses) {
+  std::vector<std::string> files{test::source_path("config/scenarios/four_corner_rig.yaml"),
+                                 test::source_path("config/scenarios/vehicle_stop.yaml")};
+  for (const auto& e : std::filesystem::directory_iterator(test::source_path("config/scenarios/faults"))) {
+    if (e.path().extension() == ".yaml") files.push_back(e.path().string());
+  }
+  for (const auto& f : files) {
+    const auto fs = load_fault_scenario(f);
+    std::vector<std::string> corners;
+    for (const auto& c : fs.scenario.corners) corners.push_back(c.name);
+    EXPECT_FALSE(fs.scenario.processes.empty()) << f;
+    EXPECT_EQ(run_processes(fs.scenario.processes, corners, fs.faults).size(), corners.size() + (fs.faults.standby ? 2u : 1u)) << f;
+  }
+}

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -82,6 +84,39 @@ TEST(SystemLockstep, FiveProcessesCompleteWithoutGapsOrLostSamples) {
   EXPECT_NE(summary.find("\"not_scored_reason\": null"), std::string::npos) << summary;
   EXPECT_EQ(summary.find("\"estimate_max_abs_error_kN\": null"), std::string::npos) << summary;
   fs::remove_all(dir);
+}
+
+// Domain 167: a scenario that declares its processes (two corners) gets exactly those: the
+// CCU's barrier waits for two corners, every period completes, and no other corner ran.
+TEST(SystemLockstep, TheLauncherStartsWhatTheScenarioDeclares) {
+  const std::string dir = scratch("declared");
+  const ProcessRun r = launch("tests/system/data/two_corner_rig.yaml", dir, 167, "lockstep");
+  ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
+  const std::string out = dir + "/out";
+  EXPECT_NE(r.out.find("3 processes"), std::string::npos) << r.out;
+  const auto typed = bbw::runtime::load_ccu_stats(out + "/ccu.stats");
+  EXPECT_EQ(typed.periods_done, 400u);
+  EXPECT_EQ(typed.corners.size(), 2u);
+  for (const char* c : {"FL", "RR"}) {
+    EXPECT_EQ(stat(out + "/corner_" + std::string(c) + ".stats", "commands_applied"), 400.0) << c;
+  }
+  for (const char* c : {"FR", "RL"}) EXPECT_FALSE(fs::exists(out + "/corner_" + std::string(c) + ".stats")) << c;
+  std::string summary = slurp(out + "/summary.json");
+  summary.erase(std::remove_if(summary.begin(), summary.end(), [](unsigned char ch) { return std::isspace(ch) != 0; }),
+                summary.end());
+  EXPECT_NE(summary.find("\"processes_started\":[\"ccu\",\"FL\",\"RR\"]"), std::string::npos) << summary;
+  // A declared list that leaves a corner out is refused before anything starts.
+  std::string text = slurp(src("tests/system/data/two_corner_rig.yaml"));
+  text.replace(text.find("processes: [ccu, FL, RR]"), 24, "processes: [ccu, FL]    ");
+  text.replace(text.find("../../../config/plant/"), 22, src("config/plant/"));
+  const std::string bad = dir + "/missing_rr.yaml";
+  std::ofstream(bad) << text;
+  const ProcessRun refused = run("bbw_launch", {bin("bbw_launch"), bad, "--out", dir + "/bad", "--mode", "lockstep", "--domain", "167", "--no-report"},
+                                 dir, 60s);
+  EXPECT_EQ(refused.status.code, 2) << refused.status.describe() << "\n" << refused.err;
+  EXPECT_NE(refused.err.find("missing_rr.yaml:10: key 'processes': corner RR of this scenario has no process"), std::string::npos)
+      << refused.err;
+  if (!HasFailure()) fs::remove_all(dir);
 }
 
 // Domains 161 and 162: the same scenario and seed twice give byte-identical logs.

@@ -24,6 +24,15 @@ std::vector<FaultSpec> FaultSchedule::for_target(Target t) const {
   return out;
 }
 
+std::vector<std::string> run_processes(const std::vector<std::string>& declared, const std::vector<std::string>& scenario_corners,
+                                       const FaultSchedule& schedule) {
+  if (!declared.empty()) return declared;
+  std::vector<std::string> out{"ccu"};
+  if (schedule.standby) out.emplace_back("ccu_standby");
+  out.insert(out.end(), scenario_corners.begin(), scenario_corners.end());
+  return out;
+}
+
 const char* to_string(Target t) {
   switch (t) {
     case Target::FL: return "FL";

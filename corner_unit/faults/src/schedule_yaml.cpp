@@ -99,7 +99,49 @@ FaultSpec read_one(config::Reader& r) {
   return f;
 }
 
+// The declared `processes:` against the scenario: ccu once, ccu_standby exactly when the run has
+// a standby, every corner of the scenario and no other.
+void check_processes(const scenario::Scenario& s, const FaultSchedule& faults, const std::string& file) {
+  if (s.processes.empty()) return;
+  const int line = s.processes_line;
+  std::vector<std::string> seen;
+  for (const std::string& p : s.processes) {
+    if (std::find(seen.begin(), seen.end(), p) != seen.end()) {
+      throw config::ConfigError(file, line, "processes", "'" + p + "' is listed twice");
+    }
+    seen.push_back(p);
+    if (p == "vehicle" || p == "pedal") {
+      throw config::ConfigError(file, line, "processes",
+                                "'" + p + "' runs in a vehicle scenario only (config/scenarios/vehicle/)");
+    }
+    if (p == "ccu" || p == "ccu_standby") continue;
+    if (!target_from_name(p) || is_ccu(*target_from_name(p))) {
+      throw config::ConfigError(file, line, "processes",
+                                "unknown process '" + p + "' (ccu, ccu_standby, FL, FR, RL, RR)");
+    }
+    const bool in_scenario = std::any_of(s.corners.begin(), s.corners.end(),
+                                         [&](const scenario::CornerSpec& c) { return c.name == p; });
+    if (!in_scenario) throw config::ConfigError(file, line, "processes", "no corner named " + p + " in this scenario");
+  }
+  if (std::find(seen.begin(), seen.end(), "ccu") == seen.end()) {
+    throw config::ConfigError(file, line, "processes", "a run needs its CCU: list ccu");
+  }
+  for (const auto& c : s.corners) {
+    if (std::find(seen.begin(), seen.end(), c.name) == seen.end()) {
+      throw config::ConfigError(file, line, "processes",
+                                "corner " + c.name + " of this scenario has no process: list it (each corner runs as one)");
+    }
+  }
+  const bool listed_standby = std::find(seen.begin(), seen.end(), "ccu_standby") != seen.end();
+  if (listed_standby != faults.standby) {
+    throw config::ConfigError(file, line, "processes",
+                              faults.standby ? "standby: true runs a hot-standby CCU: list ccu_standby"
+                                             : "ccu_standby needs standby: true (a hot-standby run)");
+  }
+}
+
 void check_against(const scenario::Scenario& s, const FaultSchedule& faults, const std::string& file) {
+  check_processes(s, faults, file);
   for (std::size_t i = 0; i < faults.faults.size(); ++i) {
     const FaultSpec& f = faults.faults[i];
     const std::string at = "faults[" + std::to_string(i) + "]";

@@ -154,7 +154,7 @@ int main(int argc, char** argv) {
   plan.domain = domain;
   plan.discovery_s = opt.discovery_s;
   plan.secure = opt.secure;
-  plan.extra_processes = loaded->extra_processes;
+  plan.processes = loaded->processes;
   plan.standby = loaded->schedule.standby;  // the scenario's standby: true, or --standby
 
   // A SIGINT/SIGTERM before the run's processes start (while the keys are created, say) still
@@ -219,6 +219,7 @@ int main(int argc, char** argv) {
     run.secure = plan.secure;
     run.report = opt.report;
     run.incarnations = result.incarnations;
+    run.processes = plan.processes;
     run.ended_by_injected_ccu_kill = result.ccu_killed;
     run.standby = plan.standby;
     if (plan.standby) {
@@ -231,7 +232,7 @@ int main(int argc, char** argv) {
     }
     run.launch_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     const auto t = bbw::launch::write_run_summary(run);
-    if (!plan.extra_processes.empty()) bbw::launch::merge_vehicle_summary(plan.out_dir);
+    if (plan.runs("vehicle")) bbw::launch::merge_vehicle_summary(plan.out_dir);
     std::cout << "bbw_launch: done: simulated " << t.simulated_s << " s in " << t.wall_s << " s (real-time factor "
               << (t.wall_s > 0 ? t.simulated_s / t.wall_s : 0.0) << "), samples published " << t.published
               << ", received " << t.received << ", gaps " << t.gaps << "; " << plan.out_dir << "/summary.json"

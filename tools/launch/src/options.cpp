@@ -1,5 +1,7 @@
 #include "options.hpp"
 
+#include <algorithm>
+
 #include <cstdlib>
 #include <stdexcept>
 
@@ -64,16 +66,20 @@ LoadedRun load_run(const Options& o) {
     if (!faults::process_actions(r.schedule).empty()) {
       throw std::invalid_argument(o.scenario_file + ": process faults in a vehicle scenario run in process only (bbw_vehicle_inproc)");
     }
-    for (const std::string& p : vs.processes) {
-      if (p == "vehicle" || p == "pedal") r.extra_processes.push_back(p);
-    }
+    r.processes = vs.processes;
   } else {
     auto fs = faults::load_fault_scenario(o.scenario_file);
     r.scenario = std::move(fs.scenario);
     r.schedule = std::move(fs.faults);
+    std::vector<std::string> corners;
+    for (const auto& c : r.scenario.corners) corners.push_back(c.name);
+    r.processes = faults::run_processes(r.scenario.processes, corners, r.schedule);
   }
   scenario::check_four_corner_run(r.scenario);
   if (o.standby) r.schedule.standby = true;
+  if (r.schedule.standby && std::find(r.processes.begin(), r.processes.end(), "ccu_standby") == r.processes.end()) {
+    r.processes.push_back("ccu_standby");  // --standby on a scenario that declares its processes
+  }
   for (const faults::FaultSpec& f : r.schedule.faults) {
     if (f.type == faults::FaultType::LinkCut) {
       throw std::invalid_argument(o.scenario_file + ": line " + std::to_string(f.line) +

@@ -37,9 +37,10 @@ int requested_domain(const Options& o);
 struct LoadedRun {
   scenario::Scenario scenario;
   faults::FaultSchedule schedule;
-  // Processes beyond the CCU and the corners that the scenario declares (a vehicle scenario,
-  // issue 15: "vehicle", "pedal"); empty for a four-corner scenario.
-  std::vector<std::string> extra_processes;
+  // The processes the scenario declares (`processes:`), or its default (ccu, ccu_standby with a
+  // standby, the corners): the launcher starts exactly these. A vehicle scenario adds "vehicle"
+  // and "pedal".
+  std::vector<std::string> processes;
 };
 
 // The scenario and its fault schedule, checked for a DDS run (four corners, size limits unless

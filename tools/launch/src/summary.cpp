@@ -142,6 +142,9 @@ RunTotals write_run_summary(const CompletedRun& run) {
   j.begin_object().value("scenario", scenario.name).value("scenario_file", run.scenario_file).value("mode", run.mode);
   j.value("domain", run.domain).value("run_id", run.run_id).value("friction_feedback", run.friction_feedback)
       .value("secure", run.secure);
+  j.begin_array("processes_started");  // the scenario's `processes:` (partial summaries: `processes`, how each ended)
+  for (const auto& p : run.processes) j.value("", p);
+  j.end_array();
   j.value("complete", true).value("interrupted", false);
   // Participants of other bbw runs seen on the domain (by any process of this run).
   std::vector<dds::PeerTag> others;

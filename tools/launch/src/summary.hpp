@@ -55,6 +55,7 @@ struct CompletedRun {
   bool secure = false;
   bool report = true;                            // also write report.html
   std::map<std::string, unsigned> incarnations;  // corner -> processes started
+  std::vector<std::string> processes;            // what the launcher started (the scenario's `processes:`)
   bool ended_by_injected_ccu_kill = false;
   double launch_wall_s = 0.0;
   // A run with a hot-standby CCU (issue 16): summary.json gets a `failover` object

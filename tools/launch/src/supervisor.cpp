@@ -140,6 +140,10 @@ Supervisor::Supervisor(RunPlan plan, const std::atomic<int>& stop_signal)
   corner_bin_ = corner_bin_env && *corner_bin_env ? corner_bin_env : bin_ + "/bbw_corner";
 }
 
+bool RunPlan::runs(const std::string& process) const {
+  return std::find(processes.begin(), processes.end(), process) != processes.end();
+}
+
 Supervisor::~Supervisor() {
   for (auto& c : children_) {
     if (!c->status()) c->stop(2000ms);
@@ -195,9 +199,12 @@ void Supervisor::start() {
                                                   plan_.out_dir + "/ccu_standby.err"));
     }
     children_.push_back(std::make_unique<Child>("bbw_ccu", ccu_args, plan_.out_dir + "/ccu.out", plan_.out_dir + "/ccu.err"));
-    for (const auto& c : plan_.scenario->corners) spawn_corner(c.name, 0, 0.0);
+    for (const auto& c : plan_.scenario->corners) {
+      if (plan_.runs(c.name)) spawn_corner(c.name, 0, 0.0);
+    }
     // The further processes the scenario declares (a vehicle run: bbw_vehicle, bbw_pedal).
-    for (const std::string& p : plan_.extra_processes) {
+    for (const std::string& p : {std::string("vehicle"), std::string("pedal")}) {
+      if (!plan_.runs(p)) continue;
       const std::string name = "bbw_" + p;
       std::vector<std::string> args{bin_ + "/" + name, "--scenario", plan_.scenario_file, "--domain",
                                     std::to_string(plan_.domain), "--run-id", plan_.run_id, "--mode", plan_.mode,

@@ -33,10 +33,15 @@ struct RunPlan {
   int domain = 0;
   double discovery_s = 20.0;
   bool secure = false;
-  std::vector<std::string> extra_processes;  // "vehicle", "pedal": bbw_vehicle, bbw_pedal (issue 15)
+  // The processes to start, as the scenario declares them (LoadedRun::processes): "ccu"
+  // (bbw_ccu), "ccu_standby" (bbw_ccu_standby, issue 16), a corner name (bbw_corner), "vehicle",
+  // "pedal" (bbw_vehicle, bbw_pedal, issue 15).
+  std::vector<std::string> processes;
   // A hot-standby CCU too (issue 16): bbw_ccu_standby (--role standby, logs and stats in
   // OUT/standby, output OUT/ccu_standby.out/.err); every process runs with --standby.
   bool standby = false;
+
+  bool runs(const std::string& process) const;
 };
 
 struct SupervisedRun {

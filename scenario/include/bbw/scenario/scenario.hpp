@@ -56,7 +56,12 @@ struct Scenario {
   std::string file;                             // the file it was loaded from ("" if built in code)
   std::uint64_t seed = 1;
   double duration_s = 10.0;
-  int duration_line = 0;                        // line of duration_s in the file (0 if built in code)
+  int duration_line = 0;
+  // Top-level `processes:` (optional; ./bbw run): the processes of the run as the launcher
+  // starts them, `ccu`, `ccu_standby` and each corner once (checked against the corners and the
+  // standby key with the fault schedule, bbw/faults/schedule_yaml.hpp). Empty when not declared.
+  std::vector<std::string> processes;
+  int processes_line = 0;                        // line of duration_s in the file (0 if built in code)
   double plant_dt_s = 0.001;
   double ccu_period_s = 0.005;                  // used by the DDS system
   std::string plant_file;                       // resolved path of the plant parameter file

@@ -58,11 +58,15 @@ struct FaultSchedule {
   // Top-level `standby: true`: the run has a hot-standby CCU (docs/faults.md). Read with the
   // schedule because it changes which process faults make sense (CCU_STANDBY, hang, link_cut).
   bool standby = false;
-
   // The faults of one target, in file order (allocates; call at set-up).
   std::vector<FaultSpec> for_target(Target t) const;
   bool empty() const { return faults.empty(); }
 };
+
+// The processes a four-corner run starts: the scenario's declared `processes:` list, or else
+// `ccu`, `ccu_standby` with `standby: true`, and the scenario's corners in scenario order.
+std::vector<std::string> run_processes(const std::vector<std::string>& declared, const std::vector<std::string>& scenario_corners,
+                                       const FaultSchedule& schedule);
 
 const char* to_string(Target t);
 const char* to_string(Part p);
