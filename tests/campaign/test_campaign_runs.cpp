@@ -160,16 +160,21 @@ TEST(CampaignSystem, TwoNetworkNamespacesServeAsTwoHosts) {
                           {spec, "--out", dir + "/c", "--jobs", "2", "--ssh", src("scripts/netns-ssh.sh"), "--sshlogin",
                            "1/" + a, "--sshlogin", "1/" + b},
                           200s);
-  ASSERT_TRUE(r.status.ok()) << r.err;
+  ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
   std::set<std::string> hosts;
+  std::string where;  // which run went where, for the failure message
   for (int i = 0; i < 4; ++i) {
     char run[16];
     std::snprintf(run, sizeof run, "%05d", i);
-    const YAML::Node res = YAML::LoadFile(dir + "/c/runs/" + run + "/result.json");
-    EXPECT_TRUE(res["ok"].as<bool>()) << res["error"].as<std::string>();
+    const std::string rd = dir + "/c/runs/" + run;
+    ASSERT_TRUE(fs::exists(rd + "/result.json")) << run << " has no result\n" << r.out << r.err;
+    const YAML::Node res = YAML::LoadFile(rd + "/result.json");
+    EXPECT_TRUE(res["ok"].as<bool>()) << run << ": " << res["error"].as<std::string>() << "\n"
+                                      << (fs::exists(rd + "/run.err") ? slurp(rd + "/run.err") : std::string("(no run.err)"));
     EXPECT_EQ(res["transport"].as<std::string>(), "dds");
     hosts.insert(res["host"].as<std::string>());
+    where += std::string(run) + " on '" + res["host"].as<std::string>() + "' " + res["wall_s"].as<std::string>() + " s; ";
   }
-  EXPECT_EQ(hosts, (std::set<std::string>{a, b}));
+  EXPECT_EQ(hosts, (std::set<std::string>{a, b})) << where << "\n" << r.out << r.err;
   if (!HasFailure()) fs::remove_all(dir);
 }
