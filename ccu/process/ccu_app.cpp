@@ -1,5 +1,7 @@
 #include "ccu_app.hpp"
 
+#include <cstdlib>
+
 #include <signal.h>
 
 #include <algorithm>
@@ -386,26 +388,51 @@ int CcuApp::run(std::string& error) {
   bool retired = false;
   std::uint32_t expected_incarnation[kSlots] = {};
   if (options_.mode == ClockMode::Lockstep) {
-    for (std::uint64_t k = 0; k < periods_ && !events_.interrupted(); ++k) {
+    // The periods run on the thread that receives their last block (run_on_receive) until
+    // something needs this loop: a failure, the end, a stall. A standby run and scheduled
+    // process faults stay on this loop throughout.
+    const char* on_receive_env = std::getenv("BBW_LOCKSTEP_ON_RECEIVE");
+    const bool on_receive = !options_.standby && !kill_at_s_ && !hang_at_s_ && restarts_.empty() &&
+                            !(on_receive_env != nullptr && std::string(on_receive_env) == "0");
+    std::uint64_t k_from = 0;
+    bool resumed = false;  // k_from's commands were sent on the receiving thread
+    bool skip_loop = false;
+    if (on_receive) {
+      if (brake_) brake_->plan(node_);
+      send_commands(0, false);
+      const ReceiveRun r = run_on_receive();
+      if (!receive_failure_.empty()) {
+        error = receive_failure_;
+        rc = kExitPeerLost;
+        skip_loop = true;
+      } else if (r == ReceiveRun::Interrupted) {
+        skip_loop = true;
+      }
+      k_from = next_k_;
+      resumed = next_begun_;
+    }
+    for (std::uint64_t k = k_from; !skip_loop && k < periods_ && !events_.interrupted(); ++k) {
       const double t_k = node_.period_start_s(k);
-      if (kill_at_s_ && t_k >= *kill_at_s_ - 1e-9) freeze_for_kill(t_k);
-      if (hang_at_s_ && t_k >= *hang_at_s_ - 1e-9) {
-        freeze_for_hang(t_k);
-        // A lockstep CCU cannot rejoin the lock step after a stop (the corners went on under the
-        // other CCU; the blocks it missed are gone): it leaves the run.
-        std::cout << "bbw_ccu (" << options_.role << "): resumed after a hang in lockstep: leaves the run at " << t_k
-                  << " s" << std::endl;
-        retired = true;
-        break;
-      }
-      for (const auto& [step, slot] : restarts_) {
-        if (step != k) continue;
-        for (std::size_t i = 0; i < node_.channels(); ++i) {
-          if (node_.channel(i).slot == slot && !wait_for_rejoin(i, ++expected_incarnation[slot], error)) return kExitPeerLost;
+      if (!(resumed && k == k_from)) {  // else begun on the receiving thread
+        if (kill_at_s_ && t_k >= *kill_at_s_ - 1e-9) freeze_for_kill(t_k);
+        if (hang_at_s_ && t_k >= *hang_at_s_ - 1e-9) {
+          freeze_for_hang(t_k);
+          // A lockstep CCU cannot rejoin the lock step after a stop (the corners went on under the
+          // other CCU; the blocks it missed are gone): it leaves the run.
+          std::cout << "bbw_ccu (" << options_.role << "): resumed after a hang in lockstep: leaves the run at " << t_k
+                    << " s" << std::endl;
+          retired = true;
+          break;
         }
+        for (const auto& [step, slot] : restarts_) {
+          if (step != k) continue;
+          for (std::size_t i = 0; i < node_.channels(); ++i) {
+            if (node_.channel(i).slot == slot && !wait_for_rejoin(i, ++expected_incarnation[slot], error)) return kExitPeerLost;
+          }
+        }
+        if (brake_) brake_->plan(node_);  // from the vehicle's and pedal's readings of period k - 1
+        send_commands(k, false);
       }
-      if (brake_) brake_->plan(node_);  // from the vehicle's and pedal's readings of period k - 1
-      send_commands(k, false);
       const double t_end = node_.period_end_s(k);
       // Wait until every corner's block k has arrived, or its writer is gone (a dead process).
       // A command is re-sent every 200 ms without progress: a corner that has just (re)joined
@@ -526,6 +553,82 @@ int CcuApp::run(std::string& error) {
   for (auto& c : commands_) c->get().get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(1, 0));
   if (log_ != nullptr) log_->flush();
   return rc;
+}
+
+bool CcuApp::lockstep_period_complete(std::uint64_t k) {
+  const double t_end = node_.period_end_s(k);
+  drain_blocks(t_end, k);
+  drain_vehicle();
+  drain_health();
+  drain_qos_events(t_end, true);
+  if (!node_.period_complete(k)) return false;
+  if (const std::string failed = node_.end_lockstep_period(k, t_end); !failed.empty()) {
+    receive_failure_ = "corner " + failed + " reported failure at period " + std::to_string(k);
+    return true;
+  }
+  node_.after_period(t_end);
+  periods_done_ = k + 1;
+  return true;
+}
+
+void CcuApp::advance_on_receive() {
+  while (lockstep_period_complete(next_k_)) {
+    ++progress_;
+    next_begun_ = false;
+    if (!receive_failure_.empty()) {
+      need_main_ = true;
+      return;
+    }
+    ++next_k_;
+    if (next_k_ >= periods_ || events_.interrupted()) {
+      need_main_ = true;  // run()'s loop begins what is left (nothing at the end)
+      return;
+    }
+    if (brake_) brake_->plan(node_);  // from the vehicle's and pedal's readings of period k - 1
+    send_commands(next_k_, false);
+    next_begun_ = true;
+  }
+}
+
+CcuApp::ReceiveRun CcuApp::run_on_receive() {
+  {
+    std::lock_guard<std::mutex> lock(run_mutex_);
+    next_k_ = 0;
+    next_begun_ = true;  // run() sent period 0's commands
+    need_main_ = false;
+    advance_on_receive();
+  }
+  events_.set_data_hook([this] {
+    // Never waits (dds::Events::data_arrived): when run() holds the lock, it takes the data.
+    std::unique_lock<std::mutex> lock(run_mutex_, std::try_to_lock);
+    if (!lock.owns_lock() || need_main_) return false;
+    advance_on_receive();
+    return !need_main_;
+  });
+  ReceiveRun result = ReceiveRun::HandedBack;
+  std::uint64_t seen = 0;
+  for (;;) {
+    const bool handed_back = events_.wait_for(std::chrono::milliseconds(200), [&] {
+      std::lock_guard<std::mutex> lock(run_mutex_);
+      if (!need_main_) advance_on_receive();
+      return need_main_;
+    });
+    if (handed_back) break;
+    if (events_.interrupted()) {
+      result = ReceiveRun::Interrupted;
+      break;
+    }
+    std::lock_guard<std::mutex> lock(run_mutex_);
+    if (progress_ == seen) {  // 200 ms without a period: run()'s loop re-sends and times out
+      result = ReceiveRun::Stalled;
+      break;
+    }
+    seen = progress_;
+  }
+  events_.set_data_hook({});
+  std::lock_guard<std::mutex> lock(run_mutex_);
+  need_main_ = true;
+  return result;
 }
 
 void CcuApp::write_stats(const std::string& file) const {

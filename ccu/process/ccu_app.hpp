@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -92,6 +93,14 @@ class CcuApp {
   void write_failover_stats() const;
   double realtime_now_s() const;
   void drain_vehicle();
+  // Lockstep on the receiving thread (docs/benchmarks.md, "Node cores and transports"): the
+  // period whose blocks complete on a Fast DDS thread is ended there and the next one begun
+  // (plan, commands); a failure, the end or a 200 ms stall go back to run()'s loop at next_k_,
+  // its commands already sent. Called with run_mutex_ held.
+  bool lockstep_period_complete(std::uint64_t k);
+  void advance_on_receive();
+  enum class ReceiveRun { HandedBack, Stalled, Interrupted };
+  ReceiveRun run_on_receive();
 
   const scenario::Scenario& scenario_;
   CcuOptions options_;
@@ -147,6 +156,14 @@ class CcuApp {
   std::size_t vehicle_participant_ = 0, pedal_participant_ = 0;
   msg::VehicleSensors vehicle_msg_;
   msg::PedalSample pedal_msg_;
+  // Lockstep on the receiving thread: the period whose blocks are awaited (its commands sent),
+  // whether run() must take over, and a corner's failure seen there.
+  std::mutex run_mutex_;
+  std::uint64_t next_k_ = 0;
+  bool next_begun_ = false;  // next_k_'s commands were sent
+  bool need_main_ = true;
+  std::string receive_failure_;
+  std::uint64_t progress_ = 0;  // periods completed on the receiving thread
 };
 
 }  // namespace bbw::ccu

@@ -124,7 +124,7 @@ class Reader : private eprosima::fastdds::dds::DataReaderListener {
   eprosima::fastdds::dds::DataReader& get() { return *reader_; }
 
  private:
-  void on_data_available(eprosima::fastdds::dds::DataReader*) override { events_.notify(); }
+  void on_data_available(eprosima::fastdds::dds::DataReader*) override { events_.data_arrived(); }
   void on_subscription_matched(eprosima::fastdds::dds::DataReader*,
                                const eprosima::fastdds::dds::SubscriptionMatchedStatus& s) override {
     matched_.store(s.current_count);
