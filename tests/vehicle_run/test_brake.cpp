@@ -35,6 +35,22 @@ TEST(SpeedEstimator, FollowsTheIMUWhileTheWheelsSlip) {
   EXPECT_GT(e.speed_m_s(), 0.93 * v);  // not dragged down to the slipping wheels
 }
 
+TEST(SpeedEstimator, ASensorsFirstEdgeTeachesNoImuBias) {
+  // The wheel-speed sensors read 0 until their first tooth edge, then the speed: that step is no
+  // acceleration of the car. Rolling at 12.5 m/s with a true IMU (ax 0) the estimate must stay
+  // at the wheels' speed once braking begins (it learned a bias of -6 m/s^2 from that step and
+  // then ran away upwards while the car braked).
+  SpeedEstimatorParams p;
+  SpeedEstimator e(p, 0.344);
+  const double w = 12.5 / 0.344;
+  e.update(0.005, {w, w, w, w}, 0.0, false);
+  e.update(0.005, {0.0, 0.0, 0.0, 0.0}, 0.0, false);  // no edge yet
+  for (int i = 0; i < 100; ++i) e.update(0.005, {w, w, w, w}, 0.0, false);
+  EXPECT_LT(std::abs(e.bias_m_s2()), 0.1);
+  for (int i = 0; i < 200; ++i) e.update(0.005, {w, w, w, w}, 0.0, true, 0.0);  // braking hard, wheels free
+  EXPECT_NEAR(e.speed_m_s(), 12.5, 0.1);
+}
+
 TEST(SlipController, PassesTheDriverThroughBelowTheTargetAndLimitsAbove) {
   SlipControlParams p;
   SlipController c(p, 0.344, 1.7);

@@ -31,7 +31,8 @@ void BrakeControlParams::validate() const {
           "slip: gains >= 0, min_speed_m_s and mu_filter_s > 0, dither_half_period_s > dither_settle_s");
   require(yaw.asymmetry_ratio > 0 && yaw.asymmetry_ratio < 1 && yaw.ramp_Nm_per_s > 0 && yaw.initial_Nm >= 0,
           "yaw: asymmetry_ratio in (0, 1), ramp_Nm_per_s > 0, initial_Nm >= 0");
-  require(speed.up_gain_per_s > 0 && speed.down_gain_per_s >= 0 && speed.rolling_gain_per_s > 0 && speed.bias_gain_per_s >= 0,
+  require(speed.up_gain_per_s > 0 && speed.down_gain_per_s >= 0 && speed.rolling_gain_per_s > 0 && speed.bias_gain_per_s >= 0 &&
+              speed.bias_max_wheel_accel_m_s2 > 0,
           "speed: gains must be >= 0 (up and rolling > 0)");
 }
 

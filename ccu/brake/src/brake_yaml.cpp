@@ -43,6 +43,7 @@ BrakeControlParams read_brake_control(Reader& r) {
     p.speed.down_gain_per_s = c.number("down_gain_per_s", Range::non_negative());
     p.speed.rolling_gain_per_s = c.number("rolling_gain_per_s", Range::positive());
     p.speed.bias_gain_per_s = c.number("bias_gain_per_s", Range::non_negative());
+    p.speed.bias_max_wheel_accel_m_s2 = c.number("bias_max_wheel_accel_m_s2", Range::positive());
     p.speed.wheel_filter_s = c.number("wheel_filter_s", Range::positive());
     c.finish();
   }

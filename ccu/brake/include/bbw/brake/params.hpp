@@ -37,6 +37,9 @@ struct SpeedEstimatorParams {
   double down_gain_per_s = 0.5;         // towards it when it reads slower while braking hard
   double rolling_gain_per_s = 20.0;     // towards it when no wheel is braked hard
   double bias_gain_per_s = 0.5;         // IMU bias learning while rolling freely
+  // ... only from wheel accelerations a car can have: a larger one is a sensor's first edge or a
+  // dropout (the wheel-speed sensor reads 0 until its first tooth), not the car.
+  double bias_max_wheel_accel_m_s2 = 15.0;
   double wheel_filter_s = 0.005;
 };
 
