@@ -74,6 +74,7 @@ struct YawLimitParams {
   bool enabled = true;
   double asymmetry_ratio = 0.6;         // a front wheel's ABS torque below this share of the other's: split-mu
   double min_difference_Nm = 300.0;     // ... and more than this apart (noise on low mu is no split)
+  double min_mu_difference = 0.0;       // ... and the tyres' estimated mu more than this apart
   double ramp_Nm_per_s = 1000.0;        // how fast the high side may exceed the low side
   double initial_Nm = 200.0;
   // Yaw-rate feedback (from measurements only): the measured yaw rate beyond the one the driver
@@ -82,6 +83,10 @@ struct YawLimitParams {
   double yaw_error_gain_Nm_per_rad_s = 8000.0;
   // ... and the heading error (that yaw-rate error integrated since the brake was applied).
   double heading_error_gain_Nm_per_rad = 0.0;
+  // Released as the driver counter-steers: the high side may exceed the low side further by this
+  // torque per rad of road-wheel steering towards the low side since the split was seen (the
+  // moment a counter-steer balances: 2 R l_f C_f / t_f per rad).
+  double counter_steer_gain_Nm_per_rad = 0.0;
   // Reference yaw rate latched when the split is seen (true) or the driver's steering now (false).
   bool latch_driver_yaw_rate = false;
   bool rear_select_low = true;
