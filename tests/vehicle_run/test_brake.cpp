@@ -35,6 +35,22 @@ TEST(SpeedEstimator, FollowsTheIMUWhileTheWheelsSlip) {
   EXPECT_GT(e.speed_m_s(), 0.93 * v);  // not dragged down to the slipping wheels
 }
 
+TEST(SpeedEstimator, ASensorsFirstEdgeTeachesNoImuBias) {
+  // The wheel-speed sensors read 0 until their first tooth edge, then the speed: that step is no
+  // acceleration of the car. Rolling at 12.5 m/s with a true IMU (ax 0) the estimate must stay
+  // at the wheels' speed once braking begins (it learned a bias of -6 m/s^2 from that step and
+  // then ran away upwards while the car braked).
+  SpeedEstimatorParams p;
+  SpeedEstimator e(p, 0.344);
+  const double w = 12.5 / 0.344;
+  e.update(0.005, {w, w, w, w}, 0.0, false);
+  e.update(0.005, {0.0, 0.0, 0.0, 0.0}, 0.0, false);  // no edge yet
+  for (int i = 0; i < 100; ++i) e.update(0.005, {w, w, w, w}, 0.0, false);
+  EXPECT_LT(std::abs(e.bias_m_s2()), 0.1);
+  for (int i = 0; i < 200; ++i) e.update(0.005, {w, w, w, w}, 0.0, true, 0.0);  // braking hard, wheels free
+  EXPECT_NEAR(e.speed_m_s(), 12.5, 0.1);
+}
+
 TEST(SlipController, PassesTheDriverThroughBelowTheTargetAndLimitsAbove) {
   SlipControlParams p;
   SlipController c(p, 0.344, 1.7);
@@ -145,4 +161,40 @@ TEST(BrakeController, ALostCornersShareGoesToTheSameSideWheelOfTheOtherAxle) {
   const BrakeOutput rear = lost_corner_run(true, 3);
   EXPECT_EQ(rear.clamp_force_kN[3], 0.0);
   EXPECT_GT(rear.torque_Nm[1], rear.torque_Nm[0]);
+}
+
+namespace {
+// Split-mu, FL on ice: FL slips 20 % with next to no torque, FR rolls with the driver's torque and
+// a tyre that carries it. steer_rad: the driver's steering (left positive) from the start.
+BrakeOutput split_run(double steer_rad, double counter_steer_gain) {
+  BrakeControlParams p;
+  p.yaw.counter_steer_gain_Nm_per_rad = counter_steer_gain;
+  p.yaw.latch_driver_yaw_rate = true;  // as shipped (config/vehicle/brake_control.yaml)
+  BrakeController b(p);
+  BrakeMeasurements m;
+  for (double& w : m.wheel_rad_s) w = 20.0 / 0.344;
+  m.pedal_travel_mm = p.pedal.full_travel_mm;
+  m.pedal_force_N = p.pedal.full_force_N;
+  m.ax_m_s2 = -4.0;
+  m.wheel_rad_s[0] = 0.8 * 20.0 / 0.344;
+  m.clamp_estimate_kN = {0.3, 10.0, 0.3, 6.0};
+  for (int i = 0; i < 60; ++i) b.update(0.005, m);
+  EXPECT_TRUE(b.last().split_mu);
+  // The driver counter-steers after the split was seen; the car does not yaw (the reference is
+  // the yaw rate the driver steered for when the split was seen).
+  m.steer_rad = steer_rad;
+  for (int i = 0; i < 20; ++i) b.update(0.005, m);
+  return b.last();
+}
+}  // namespace
+
+TEST(BrakeController, TheHighSideIsReleasedAsTheDriverCounterSteers) {
+  const BrakeOutput none = split_run(0.0, 25000.0);
+  ASSERT_TRUE(none.split_mu);
+  // Counter-steer towards the low side (left): the high side (FR) may brake more, by the gain.
+  const BrakeOutput counter = split_run(0.02, 25000.0);
+  EXPECT_NEAR(counter.torque_Nm[1] - none.torque_Nm[1], 25000.0 * 0.02, 60.0);
+  // Steering towards the high side releases nothing; without the gain nothing either.
+  EXPECT_LE(split_run(-0.02, 25000.0).torque_Nm[1], none.torque_Nm[1] + 1.0);
+  EXPECT_NEAR(split_run(0.02, 0.0).torque_Nm[1], none.torque_Nm[1], 60.0);
 }

@@ -147,9 +147,10 @@ TEST(VehicleRun, ALostCornersBrakingGoesToTheOtherThree) {
 }
 
 TEST(VehicleRun, IceMeetsTheDistanceGoalAndSplitMuStaysWithinItsMeasuredBounds) {
-  // docs/vehicle.md, issue 15 second part (measured once, after tuning on the tuning set):
-  // ice ratio 1.051 (goal <= 1.10, met), epsilon 0.890 (goal 0.95 not met: regression bound);
-  // split-mu 95.44 m, lateral 1.23 m (goal 0.5 m not met: regression bounds).
+  // docs/vehicle.md, issue 15 third part (measured once, after tuning on the tuning set):
+  // ice ratio 0.946 (goal <= 1.10, met), epsilon 0.952 (regression bound 0.85: not robust);
+  // split-mu 115.29 m, lateral 0.86 m (goal 0.5 m not met: regression bounds; the yaw-moment
+  // limitation now trades distance for lane keeping, 94.26 m / 1.30 m before).
   auto ice = vehicle_run::load_vehicle_scenario(scen("ice_straight_100kmh"));
   vehicle_run::VehicleRun a(ice, calibrator(), {});
   a.run();
@@ -162,8 +163,27 @@ TEST(VehicleRun, IceMeetsTheDistanceGoalAndSplitMuStaysWithinItsMeasuredBounds) 
   b.run();
   const auto ms = vehicle_run::vehicle_metrics(split, b);
   EXPECT_TRUE(ms.stopped);
-  EXPECT_LT(ms.stopping_distance_m, 100.0);
-  EXPECT_LT(ms.max_lateral_deviation_m, 1.35);
+  EXPECT_LT(ms.stopping_distance_m, 125.0);
+  EXPECT_LT(ms.max_lateral_deviation_m, 1.0);
+}
+
+TEST(VehicleRun, TheSplitMuDetectionStaysQuietInACurveAndOnUniformSnow) {
+  // Issue 15 third part: braking in a curve loads the outer wheels, so the inner front wheel's ABS
+  // torque falls below 0.6 of the outer's - no split-mu (the detection compares torque per
+  // estimated wheel load and the tyres' estimated mu); on uniform snow the slip controllers'
+  // torques swing apart for a moment - no split-mu either (it fired at 0.97 s and 0.30 s before).
+  for (const char* name : {"tuning/t_curve_dry_b_right_80m_65kmh", "tuning/t_snow_b_120"}) {
+    const auto s = vehicle_run::load_vehicle_scenario(scen(name));
+    vehicle_run::VehicleRun r(s, calibrator(), {});
+    r.run();
+    for (const auto& t : r.trace()) ASSERT_FALSE(t.split_mu) << name << " at " << t.time_s << " s";
+  }
+  const auto split = vehicle_run::load_vehicle_scenario(scen("split_mu_dry_ice_100kmh"));
+  vehicle_run::VehicleRun b(split, calibrator(), {});
+  b.run();
+  bool seen = false;
+  for (const auto& t : b.trace()) seen = seen || (t.split_mu && t.time_s < 0.5);
+  EXPECT_TRUE(seen);
 }
 
 TEST(VehicleRun, TheCaliperTemperatureComesFromTheDriving) {

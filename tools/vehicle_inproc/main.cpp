@@ -39,7 +39,7 @@ int usage(const std::string& why) {
 void write_csv(const std::string& file, const std::vector<bbw::vehicle_run::PeriodTrace>& tr) {
   std::ofstream f(file);
   if (!f) throw std::runtime_error(file + ": cannot write");
-  f << "time_s,speed_m_s,speed_estimate_m_s,x_m,y_m,yaw_rate_deg_s,ax_m_s2,path_m,steer_deg,demand";
+  f << "time_s,speed_m_s,speed_estimate_m_s,x_m,y_m,yaw_rate_deg_s,ax_m_s2,path_m,steer_deg,demand,split_mu";
   const char* n[4] = {"FL", "FR", "RL", "RR"};
   for (const char* c : n) {
     f << ",wheel_speed_" << c << "_m_s,slip_" << c << ",mu_used_" << c << ",surface_mu_scale_" << c << ",command_" << c
@@ -49,7 +49,7 @@ void write_csv(const std::string& file, const std::vector<bbw::vehicle_run::Peri
   for (const auto& t : tr) {
     f << t.time_s << ',' << t.speed_m_s << ',' << t.speed_estimate_m_s << ',' << t.x_m << ',' << t.y_m << ','
       << t.yaw_rate_rad_s * 180.0 / M_PI << ',' << t.ax_m_s2 << ',' << t.path_m << ',' << t.steer_rad * 180.0 / M_PI << ','
-      << t.demand;
+      << t.demand << ',' << (t.split_mu ? 1 : 0);
     for (std::size_t w = 0; w < 4; ++w) {
       f << ',' << t.wheel_speed_m_s[w] << ',' << t.slip[w] << ',' << t.mu_used[w] << ',' << t.surface_mu_scale[w] << ','
         << t.command_kN[w] << ',' << t.clamp_true_kN[w] << ',' << t.clamp_estimate_kN[w] << ',' << t.disc_C[w] << ','

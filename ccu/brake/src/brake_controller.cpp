@@ -31,7 +31,8 @@ void BrakeControlParams::validate() const {
           "slip: gains >= 0, min_speed_m_s and mu_filter_s > 0, dither_half_period_s > dither_settle_s");
   require(yaw.asymmetry_ratio > 0 && yaw.asymmetry_ratio < 1 && yaw.ramp_Nm_per_s > 0 && yaw.initial_Nm >= 0,
           "yaw: asymmetry_ratio in (0, 1), ramp_Nm_per_s > 0, initial_Nm >= 0");
-  require(speed.up_gain_per_s > 0 && speed.down_gain_per_s >= 0 && speed.rolling_gain_per_s > 0 && speed.bias_gain_per_s >= 0,
+  require(speed.up_gain_per_s > 0 && speed.down_gain_per_s >= 0 && speed.rolling_gain_per_s > 0 && speed.bias_gain_per_s >= 0 &&
+              speed.bias_max_wheel_accel_m_s2 > 0,
           "speed: gains must be >= 0 (up and rolling > 0)");
 }
 
@@ -169,13 +170,24 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
     auto capacity = [&](std::size_t w) {
       return out_.wheels[w].active ? std::max(0.0, out_.wheels[w].mu_estimate) * std::max(100.0, load[w]) * c.wheel_radius_m : 0.0;
     };
-    const std::size_t low_side = split_ ? low_side_ : (out_.torque_Nm[0] <= out_.torque_Nm[1] ? 0 : 1);
+    // Torque per estimated wheel load (the adhesion the wheel uses): in a curve the inner wheel
+    // carries less torque because it carries less load, not because its road is slippery.
+    auto per_load = [&](std::size_t w, double torque_Nm) { return torque_Nm / std::max(100.0, load[w]); };
+    const std::size_t low_side =
+        split_ ? low_side_ : (per_load(0, out_.torque_Nm[0]) <= per_load(1, out_.torque_Nm[1]) ? 0 : 1);
     // The low side's reference: its command, but not below a share of what its tyre carries (a
     // low-mu wheel's slip controller releasing for a moment must not take the high side down with it).
     const double lo = std::max(out_.torque_Nm[low_side], p_.yaw.low_side_capacity_share * capacity(low_side));
     const double hi = out_.torque_Nm[1 - low_side];
-    const bool asym = (out_.wheels[low_side].active || !m.available[low_side]) && hi > 0.0 &&
-                      lo < p_.yaw.asymmetry_ratio * hi && hi - lo > p_.yaw.min_difference_Nm;
+    // Only where the slip controllers act (above their hand-over speed, where a wheel's ABS torque
+    // against the other's driver torque says nothing about the road).
+    const bool slip_controlled = v - std::abs(m.yaw_rate_rad_s) * 0.5 * c.track_front_m >= p_.slip.min_speed_m_s;
+    const bool asym = slip_controlled && (out_.wheels[low_side].active || !m.available[low_side]) && hi > 0.0 &&
+                      per_load(low_side, lo) < p_.yaw.asymmetry_ratio * per_load(1 - low_side, hi) &&
+                      hi - lo > p_.yaw.min_difference_Nm &&
+                      // ... and the tyres' estimated mu that far apart: on a uniform low-mu road the
+                      // slip controllers' torques swing apart for a moment, their tyres' mu do not.
+                      out_.wheels[1 - low_side].mu_estimate - out_.wheels[low_side].mu_estimate > p_.yaw.min_mu_difference;
     if (asym && !split_) {
       split_ = true;
       split_s_ = 0.0;
@@ -183,6 +195,7 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
       // The heading and the reference count from here (tuning set: better than from brake onset).
       heading_error_rad_ = 0.0;
       brake_driver_yaw_rate_ = driver_yaw_rate;
+      brake_steer_rad_ = m.steer_rad;
     }
     if (split_) {
       split_s_ += dt_s;
@@ -197,7 +210,10 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
       // (The yaw-rate error integrated, never below 0.)
       heading_error_rad_ = std::max(0.0, heading_error_rad_ + towards_high * dt_s);
       const double heading_towards_high = heading_error_rad_;
-      const double allowed = std::max(lo, lo + p_.yaw.initial_Nm + p_.yaw.ramp_Nm_per_s * split_s_ -
+      // The driver's counter-steer (towards the low side, left positive) since the split was seen.
+      const double counter_steer = (low_side == 0 ? 1.0 : -1.0) * (m.steer_rad - brake_steer_rad_);
+      const double allowed = std::max(lo, lo + p_.yaw.initial_Nm + p_.yaw.ramp_Nm_per_s * split_s_ +
+                                              p_.yaw.counter_steer_gain_Nm_per_rad * std::max(0.0, counter_steer) -
                                               p_.yaw.yaw_error_gain_Nm_per_rad_s * std::max(0.0, towards_high) -
                                               p_.yaw.heading_error_gain_Nm_per_rad * heading_towards_high);
       out_.torque_Nm[1 - low_side] = std::min(out_.torque_Nm[1 - low_side], allowed);

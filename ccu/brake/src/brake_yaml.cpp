@@ -43,6 +43,7 @@ BrakeControlParams read_brake_control(Reader& r) {
     p.speed.down_gain_per_s = c.number("down_gain_per_s", Range::non_negative());
     p.speed.rolling_gain_per_s = c.number("rolling_gain_per_s", Range::positive());
     p.speed.bias_gain_per_s = c.number("bias_gain_per_s", Range::non_negative());
+    p.speed.bias_max_wheel_accel_m_s2 = c.number("bias_max_wheel_accel_m_s2", Range::positive());
     p.speed.wheel_filter_s = c.number("wheel_filter_s", Range::positive());
     c.finish();
   }
@@ -73,10 +74,12 @@ BrakeControlParams read_brake_control(Reader& r) {
     p.yaw.enabled = c.boolean("enabled");
     p.yaw.asymmetry_ratio = c.number("asymmetry_ratio", Range{0.0, 1.0, true, true});
     p.yaw.min_difference_Nm = c.number("min_difference_Nm", Range::non_negative());
+    p.yaw.min_mu_difference = c.number("min_mu_difference", Range::closed(0, 1));
     p.yaw.ramp_Nm_per_s = c.number("ramp_Nm_per_s", Range::positive());
     p.yaw.initial_Nm = c.number("initial_Nm", Range::non_negative());
     p.yaw.yaw_error_gain_Nm_per_rad_s = c.number("yaw_error_gain_Nm_per_rad_s", Range::non_negative());
     p.yaw.heading_error_gain_Nm_per_rad = c.number("heading_error_gain_Nm_per_rad", Range::non_negative());
+    p.yaw.counter_steer_gain_Nm_per_rad = c.number("counter_steer_gain_Nm_per_rad", Range::non_negative());
     p.yaw.latch_driver_yaw_rate = c.boolean("latch_driver_yaw_rate");
     p.yaw.rear_select_low = c.boolean("rear_select_low");
     p.yaw.low_side_capacity_share = c.number("low_side_capacity_share", Range::closed(0, 1));

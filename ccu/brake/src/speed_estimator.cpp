@@ -27,9 +27,12 @@ double SpeedEstimator::update(double dt_s, const std::array<double, 4>& w, doubl
     v_ += std::min(1.0, p_.down_gain_per_s * dt_s) * (corrected - v_);
   }
   if (!braking_hard && raw > 1.0) {
-    // Rolling freely: the wheels' own acceleration tells the IMU's bias.
+    // Rolling freely: the wheels' own acceleration tells the IMU's bias - when it is one a car can
+    // have: a wheel-speed sensor reads 0 until its first tooth edge, and that step is no
+    // acceleration (it once taught a bias of -6 m/s^2 that overestimated every stop's speed).
     const double wheel_accel = (raw - prev_ref_) / dt_s;
-    bias_ += std::min(1.0, p_.bias_gain_per_s * dt_s) * ((ax_m_s2 - wheel_accel) - bias_);
+    if (std::abs(wheel_accel) <= p_.bias_max_wheel_accel_m_s2)
+      bias_ += std::min(1.0, p_.bias_gain_per_s * dt_s) * ((ax_m_s2 - wheel_accel) - bias_);
   }
   prev_ref_ = raw;
   v_ = std::max(0.0, v_);

@@ -60,6 +60,7 @@ void VehicleRun::vehicle_period(std::uint64_t k) {
   p.path_m = t.path_m;
   p.steer_rad = t.steer_rad;
   p.demand = brake_.controller().last().demand;
+  p.split_mu = brake_.controller().last().split_mu;
   p.stopped = t.stopped;
   for (std::size_t w = 0; w < 4; ++w) {
     p.wheel_speed_m_s[w] = t.wheel_speed_m_s[w];

@@ -67,6 +67,7 @@ class BrakeController {
   double lost_s_ = 0.0;         // time since a lost corner's yaw limitation began
   bool split_ = false;
   double heading_error_rad_ = 0.0;
+  double brake_steer_rad_ = 0.0;        // the steering angle when the split was seen
   double brake_driver_yaw_rate_ = 0.0;  // the driver's yaw rate when the split was seen  // yaw-rate error integrated while split_
   std::size_t low_side_ = 0;    // the front wheel on the low mu, latched while split_
   BrakeOutput out_;

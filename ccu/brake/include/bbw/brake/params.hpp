@@ -37,6 +37,9 @@ struct SpeedEstimatorParams {
   double down_gain_per_s = 0.5;         // towards it when it reads slower while braking hard
   double rolling_gain_per_s = 20.0;     // towards it when no wheel is braked hard
   double bias_gain_per_s = 0.5;         // IMU bias learning while rolling freely
+  // ... only from wheel accelerations a car can have: a larger one is a sensor's first edge or a
+  // dropout (the wheel-speed sensor reads 0 until its first tooth), not the car.
+  double bias_max_wheel_accel_m_s2 = 15.0;
   double wheel_filter_s = 0.005;
 };
 
@@ -71,6 +74,7 @@ struct YawLimitParams {
   bool enabled = true;
   double asymmetry_ratio = 0.6;         // a front wheel's ABS torque below this share of the other's: split-mu
   double min_difference_Nm = 300.0;     // ... and more than this apart (noise on low mu is no split)
+  double min_mu_difference = 0.0;       // ... and the tyres' estimated mu more than this apart
   double ramp_Nm_per_s = 1000.0;        // how fast the high side may exceed the low side
   double initial_Nm = 200.0;
   // Yaw-rate feedback (from measurements only): the measured yaw rate beyond the one the driver
@@ -79,6 +83,10 @@ struct YawLimitParams {
   double yaw_error_gain_Nm_per_rad_s = 8000.0;
   // ... and the heading error (that yaw-rate error integrated since the brake was applied).
   double heading_error_gain_Nm_per_rad = 0.0;
+  // Released as the driver counter-steers: the high side may exceed the low side further by this
+  // torque per rad of road-wheel steering towards the low side since the split was seen (the
+  // moment a counter-steer balances: 2 R l_f C_f / t_f per rad).
+  double counter_steer_gain_Nm_per_rad = 0.0;
   // Reference yaw rate latched when the split is seen (true) or the driver's steering now (false).
   bool latch_driver_yaw_rate = false;
   bool rear_select_low = true;

@@ -35,6 +35,7 @@ struct PeriodTrace {
   double x_m = 0.0, y_m = 0.0, yaw_rad = 0.0, yaw_rate_rad_s = 0.0, ax_m_s2 = 0.0, path_m = 0.0;
   double steer_rad = 0.0;
   double demand = 0.0;
+  bool split_mu = false;             // the CCU's yaw-moment limitation sees split-mu
   bool stopped = false;
   std::array<double, 4> wheel_speed_m_s{};   // truth, R omega
   std::array<double, 4> slip{};              // truth, positive braking
