@@ -1,5 +1,7 @@
 #include "ccu_app.hpp"
 
+#include "bbw/dds/receive_runner.hpp"
+
 #include <cstdlib>
 
 #include <signal.h>
@@ -391,21 +393,21 @@ int CcuApp::run(std::string& error) {
     // The periods run on the thread that receives their last block (run_on_receive) until
     // something needs this loop: a failure, the end, a stall. A standby run and scheduled
     // process faults stay on this loop throughout.
-    const char* on_receive_env = std::getenv("BBW_LOCKSTEP_ON_RECEIVE");
-    const bool on_receive = !options_.standby && !kill_at_s_ && !hang_at_s_ && restarts_.empty() &&
-                            !(on_receive_env != nullptr && std::string(on_receive_env) == "0");
+    const bool on_receive = !options_.standby && !kill_at_s_ && !hang_at_s_ && restarts_.empty() && dds::lockstep_on_receive();
     std::uint64_t k_from = 0;
     bool resumed = false;  // k_from's commands were sent on the receiving thread
     bool skip_loop = false;
     if (on_receive) {
       if (brake_) brake_->plan(node_);
       send_commands(0, false);
-      const ReceiveRun r = run_on_receive();
+      next_k_ = 0;
+      next_begun_ = true;  // period 0's commands were just sent
+      const auto end = dds::run_on_receive(events_, [this] { return advance_on_receive(); }, [this] { return progress_; });
       if (!receive_failure_.empty()) {
         error = receive_failure_;
         rc = kExitPeerLost;
         skip_loop = true;
-      } else if (r == ReceiveRun::Interrupted) {
+      } else if (end == dds::ReceiveRunEnd::Interrupted) {
         skip_loop = true;
       }
       k_from = next_k_;
@@ -571,64 +573,18 @@ bool CcuApp::lockstep_period_complete(std::uint64_t k) {
   return true;
 }
 
-void CcuApp::advance_on_receive() {
+bool CcuApp::advance_on_receive() {
   while (lockstep_period_complete(next_k_)) {
     ++progress_;
     next_begun_ = false;
-    if (!receive_failure_.empty()) {
-      need_main_ = true;
-      return;
-    }
+    if (!receive_failure_.empty()) return true;
     ++next_k_;
-    if (next_k_ >= periods_ || events_.interrupted()) {
-      need_main_ = true;  // run()'s loop begins what is left (nothing at the end)
-      return;
-    }
+    if (next_k_ >= periods_ || events_.interrupted()) return true;  // run()'s loop begins what is left
     if (brake_) brake_->plan(node_);  // from the vehicle's and pedal's readings of period k - 1
     send_commands(next_k_, false);
     next_begun_ = true;
   }
-}
-
-CcuApp::ReceiveRun CcuApp::run_on_receive() {
-  {
-    std::lock_guard<std::mutex> lock(run_mutex_);
-    next_k_ = 0;
-    next_begun_ = true;  // run() sent period 0's commands
-    need_main_ = false;
-    advance_on_receive();
-  }
-  events_.set_data_hook([this] {
-    // Never waits (dds::Events::data_arrived): when run() holds the lock, it takes the data.
-    std::unique_lock<std::mutex> lock(run_mutex_, std::try_to_lock);
-    if (!lock.owns_lock() || need_main_) return false;
-    advance_on_receive();
-    return !need_main_;
-  });
-  ReceiveRun result = ReceiveRun::HandedBack;
-  std::uint64_t seen = 0;
-  for (;;) {
-    const bool handed_back = events_.wait_for(std::chrono::milliseconds(200), [&] {
-      std::lock_guard<std::mutex> lock(run_mutex_);
-      if (!need_main_) advance_on_receive();
-      return need_main_;
-    });
-    if (handed_back) break;
-    if (events_.interrupted()) {
-      result = ReceiveRun::Interrupted;
-      break;
-    }
-    std::lock_guard<std::mutex> lock(run_mutex_);
-    if (progress_ == seen) {  // 200 ms without a period: run()'s loop re-sends and times out
-      result = ReceiveRun::Stalled;
-      break;
-    }
-    seen = progress_;
-  }
-  events_.set_data_hook({});
-  std::lock_guard<std::mutex> lock(run_mutex_);
-  need_main_ = true;
-  return result;
+  return false;  // waits for more blocks
 }
 
 void CcuApp::write_stats(const std::string& file) const {

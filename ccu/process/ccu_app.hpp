@@ -11,7 +11,6 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -93,14 +92,11 @@ class CcuApp {
   void write_failover_stats() const;
   double realtime_now_s() const;
   void drain_vehicle();
-  // Lockstep on the receiving thread (docs/benchmarks.md, "Node cores and transports"): the
-  // period whose blocks complete on a Fast DDS thread is ended there and the next one begun
-  // (plan, commands); a failure, the end or a 200 ms stall go back to run()'s loop at next_k_,
-  // its commands already sent. Called with run_mutex_ held.
+  // Lockstep on the receiving thread (bbw/dds/receive_runner.hpp): the period whose blocks are
+  // complete is ended where the last one arrives and the next one begun (plan, commands); true
+  // when run()'s loop must carry on at next_k_ (a failure, the end).
   bool lockstep_period_complete(std::uint64_t k);
-  void advance_on_receive();
-  enum class ReceiveRun { HandedBack, Stalled, Interrupted };
-  ReceiveRun run_on_receive();
+  bool advance_on_receive();
 
   const scenario::Scenario& scenario_;
   CcuOptions options_;
@@ -156,12 +152,10 @@ class CcuApp {
   std::size_t vehicle_participant_ = 0, pedal_participant_ = 0;
   msg::VehicleSensors vehicle_msg_;
   msg::PedalSample pedal_msg_;
-  // Lockstep on the receiving thread: the period whose blocks are awaited (its commands sent),
-  // whether run() must take over, and a corner's failure seen there.
-  std::mutex run_mutex_;
+  // Lockstep on the receiving thread: the period whose blocks are awaited, whether its commands
+  // were sent, and a corner's failure seen there.
   std::uint64_t next_k_ = 0;
-  bool next_begun_ = false;  // next_k_'s commands were sent
-  bool need_main_ = true;
+  bool next_begun_ = false;
   std::string receive_failure_;
   std::uint64_t progress_ = 0;  // periods completed on the receiving thread
 };

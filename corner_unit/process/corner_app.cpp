@@ -12,6 +12,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "bbw/dds/receive_runner.hpp"
 #include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/runtime/period_clock.hpp"
@@ -270,20 +271,11 @@ int CornerApp::run(std::string& error) {
   std::uint64_t k_from = first;
   // Lockstep: the periods run on the thread that receives their grant (run_on_receive); a
   // standby run (command ownership, stale commands) and process faults stay on this loop.
-  const char* on_receive_env = std::getenv("BBW_LOCKSTEP_ON_RECEIVE");
-  const bool on_receive = lockstep && !options_.standby && !options_.process_faults &&
-                          !(on_receive_env != nullptr && std::string(on_receive_env) == "0");
+  const bool on_receive = lockstep && !options_.standby && !options_.process_faults && dds::lockstep_on_receive();
   if (on_receive) {
-    switch (run_on_receive(first)) {
-      case ReceiveRun::Done: break;
-      case ReceiveRun::Interrupted: k_from = node_.periods(); break;
-      case ReceiveRun::TimedOut:
-        error = "no command for period " + std::to_string(next_k_) + " from the CCU within " +
-                std::to_string(options_.peer_timeout.count()) + " ms";
-        publish_health(msg::HEALTH_FAILED);
-        return kExitPeerLost;
-    }
-    if (k_from == first) k_from = next_k_;
+    next_k_ = first_k_ = first;
+    const auto end = dds::run_on_receive(events_, [this] { return advance_on_receive(); }, [this] { return next_k_; });
+    k_from = end == dds::ReceiveRunEnd::Interrupted ? node_.periods() : next_k_;
   }
   for (std::uint64_t k = k_from; k < node_.periods(); ++k) {
     if (options_.process_faults && node_.kill_due()) {
@@ -328,61 +320,17 @@ int CornerApp::run(std::string& error) {
   return kExitOk;
 }
 
-void CornerApp::advance_on_receive() {
+bool CornerApp::advance_on_receive() {
   for (;;) {
     drain_inputs();
     const std::uint64_t k = next_k_;
-    if (k >= node_.periods() || node_.latest_command().stop() || node_.ccu_lost() || ccu_gone()) {
-      need_main_ = true;  // the end, a stop, a lost CCU: run()'s loop carries on at next_k_
-      return;
-    }
+    // The end, a stop, a lost CCU: run()'s loop carries on at next_k_.
+    if (k >= node_.periods() || node_.latest_command().stop() || node_.ccu_lost() || ccu_gone()) return true;
     const bool vehicle_ready = vehicle_in_ == nullptr || k == first_k_ || vehicle_step_ >= static_cast<std::int64_t>(k) - 1;
-    if (!node_.granted(k) || !vehicle_ready) return;  // waits for more data
+    if (!node_.granted(k) || !vehicle_ready) return false;  // waits for more data
     simulate_period(k);
     ++next_k_;
-    last_progress_ = Clock::now();
   }
-}
-
-CornerApp::ReceiveRun CornerApp::run_on_receive(std::uint64_t first) {
-  {
-    std::lock_guard<std::mutex> lock(run_mutex_);
-    first_k_ = next_k_ = first;
-    need_main_ = false;
-    last_progress_ = Clock::now();
-    advance_on_receive();
-  }
-  events_.set_data_hook([this] {
-    // Never waits (see Events::data_arrived): when run() holds the lock, it takes the data.
-    std::unique_lock<std::mutex> lock(run_mutex_, std::try_to_lock);
-    if (!lock.owns_lock() || need_main_) return false;
-    advance_on_receive();
-    return !need_main_;
-  });
-  ReceiveRun result = ReceiveRun::Done;
-  for (;;) {
-    // Woken by what is not data (matches, liveliness, a signal) or every 200 ms; the data hook
-    // wakes it only when run() must take over. Matches and QoS events can change ccu_gone().
-    const bool handed_back = events_.wait_for(std::chrono::milliseconds(200), [&] {
-      std::lock_guard<std::mutex> lock(run_mutex_);
-      if (!need_main_) advance_on_receive();
-      return need_main_;
-    });
-    if (handed_back) break;
-    if (events_.interrupted()) {
-      result = ReceiveRun::Interrupted;
-      break;
-    }
-    std::lock_guard<std::mutex> lock(run_mutex_);
-    if (Clock::now() - last_progress_ > options_.peer_timeout) {
-      result = ReceiveRun::TimedOut;
-      break;
-    }
-  }
-  events_.set_data_hook({});
-  std::lock_guard<std::mutex> lock(run_mutex_);
-  need_main_ = true;
-  return result;
 }
 
 void CornerApp::write_stats(const std::string& file) const {

@@ -9,7 +9,6 @@
 #include <array>
 #include <chrono>
 #include <memory>
-#include <mutex>
 #include <cstdio>
 #include <cstdint>
 #include <optional>
@@ -103,12 +102,9 @@ class CornerApp {
   void write_failover_stats() const;
   [[noreturn]] void freeze_for_kill();
   void finish_stats(std::chrono::steady_clock::time_point wall0);
-  // Lockstep on the receiving thread (docs/benchmarks.md, "Node cores and transports"): the
-  // periods that only wait for their grant run where the grant arrives; everything else (a stop,
-  // a lost CCU, the end) goes back to run()'s loop at next_k_. Called with run_mutex_ held.
-  void advance_on_receive();
-  enum class ReceiveRun { Done, Interrupted, TimedOut };
-  ReceiveRun run_on_receive(std::uint64_t first);
+  // Lockstep on the receiving thread (bbw/dds/receive_runner.hpp): simulates every period whose
+  // grant is in; true when run()'s loop must carry on at next_k_ (the end, a stop, a lost CCU).
+  bool advance_on_receive();
 
   const scenario::Scenario& scenario_;
   CornerOptions options_;
@@ -139,13 +135,9 @@ class CornerApp {
   std::array<transport::EndpointId, 2> calibration_writer_{};  // the CCUs heard on CalibrationState
   std::size_t calibration_writers_ = 0;
   std::uint64_t stale_commands_ = 0;  // realtime standby run: commands dropped as written too long ago
-  // Lockstep on the receiving thread: the next period to simulate, whether run() must take over,
-  // and when a period was last simulated (the peer timeout counts from it).
-  std::mutex run_mutex_;
+  // Lockstep on the receiving thread: the next period to simulate, and the first.
   std::uint64_t next_k_ = 0;
   std::uint64_t first_k_ = 0;
-  bool need_main_ = true;
-  std::chrono::steady_clock::time_point last_progress_{};
 };
 
 }  // namespace bbw::corner_process

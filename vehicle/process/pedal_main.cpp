@@ -20,6 +20,7 @@
 #include "bbw/dds/events.hpp"
 #include "bbw/dds/participant.hpp"
 #include "bbw/dds/ports.hpp"
+#include "bbw/dds/receive_runner.hpp"
 #include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/node/corner_node.hpp"
@@ -64,33 +65,33 @@ class PedalApp {
       error = "CCU not discovered within " + std::to_string(options_.discovery_timeout.count()) + " ms";
       return kExitDiscovery;
     }
-    const std::uint64_t periods = node::periods_of(scenario_.corners.scenario);
-    const double T = scenario_.corners.scenario.ccu_period_s;
+    periods_ = node::periods_of(scenario_.corners.scenario);
+    // The samples go out on the thread that receives their grant (bbw/dds/receive_runner.hpp)
+    // until the end, a stop or a stall; then on this loop.
+    std::uint64_t k_from = 0;
+    if (dds::lockstep_on_receive()) {
+      const auto end = dds::run_on_receive(events_, [this] { return advance_on_receive(); }, [this] { return periods_done_; });
+      if (send_failed_) {
+        error = "PedalSample write failed at period " + std::to_string(periods_done_);
+        return kExitRuntime;
+      }
+      k_from = end == dds::ReceiveRunEnd::Interrupted || stopped_ ? periods_ : periods_done_;
+    }
     runtime::LockstepClock period_clock(events_, options_.peer_timeout);
-    period_clock.start(0);
-    for (std::uint64_t k = 0; k < periods && !events_.interrupted(); ++k) {
+    period_clock.start(k_from);
+    for (std::uint64_t k = k_from; k < periods_ && !events_.interrupted(); ++k) {
       // Lockstep only: the clock policy of bbw/runtime/period_clock.hpp.
-      const runtime::PeriodStart begun = period_clock.begin(k, [&] {
-        while (grants_.take(command_)) {
-          if (command_.run_id() != options_.participant.run_id || command_.corner_id() != 0) continue;
-          if (command_.stop()) stopped_ = true;
-          else granted_ = std::max(granted_, static_cast<std::int64_t>(command_.step()));
-        }
-        return stopped_ || granted_ >= static_cast<std::int64_t>(k);
-      });
+      const runtime::PeriodStart begun = period_clock.begin(k, [&] { return take_grants(k); });
       if (begun == runtime::PeriodStart::Interrupted) break;
       if (begun == runtime::PeriodStart::TimedOut) {
         error = "no grant for period " + std::to_string(k) + " within " + std::to_string(options_.peer_timeout.count()) + " ms";
         return kExitPeerLost;
       }
       if (stopped_) break;
-      // The period's end, computed as the CCU does (k T, then + T).
-      const double t_end = static_cast<double>(k) * T + T;
-      if (!samples_.send(node_.sample(k, t_end))) {
+      if (!send_sample(k)) {
         error = "PedalSample write failed at period " + std::to_string(k);
         return kExitRuntime;
       }
-      periods_done_ = k + 1;
     }
     samples_.get().get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2, 0));
     return kExitOk;
@@ -98,6 +99,40 @@ class PedalApp {
   std::uint64_t periods_done() const { return periods_done_; }
 
  private:
+  // Takes the grants (the front-left commands); true when period k is granted or the run stopped.
+  bool take_grants(std::uint64_t k) {
+    while (grants_.take(command_)) {
+      if (command_.run_id() != options_.participant.run_id || command_.corner_id() != 0) continue;
+      if (command_.stop()) stopped_ = true;
+      else granted_ = std::max(granted_, static_cast<std::int64_t>(command_.step()));
+    }
+    return stopped_ || granted_ >= static_cast<std::int64_t>(k);
+  }
+
+  // Publishes period k's sample; false when the write failed.
+  bool send_sample(std::uint64_t k) {
+    // The period's end, computed as the CCU does (k T, then + T).
+    const double T = scenario_.corners.scenario.ccu_period_s;
+    const double t_end = static_cast<double>(k) * T + T;
+    if (!samples_.send(node_.sample(k, t_end))) return false;
+    periods_done_ = k + 1;
+    return true;
+  }
+
+  // Every granted period's sample; true when run()'s loop must carry on (the end, a stop, a failed write).
+  bool advance_on_receive() {
+    for (;;) {
+      const std::uint64_t k = periods_done_;
+      if (k >= periods_ || events_.interrupted()) return true;
+      if (!take_grants(k)) return false;
+      if (stopped_) return true;
+      if (!send_sample(k)) {
+        send_failed_ = true;
+        return true;
+      }
+    }
+  }
+
   const vehicle_run::VehicleScenario& scenario_;
   runtime::ProcessOptions options_;
   dds::Events& events_;
@@ -108,6 +143,8 @@ class PedalApp {
   msg::ClampCommand command_;
   std::int64_t granted_ = -1;
   bool stopped_ = false;
+  std::uint64_t periods_ = 0;
+  bool send_failed_ = false;
   std::uint64_t periods_done_ = 0;
 };
 

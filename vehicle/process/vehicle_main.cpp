@@ -24,6 +24,7 @@
 #include "bbw/dds/events.hpp"
 #include "bbw/dds/participant.hpp"
 #include "bbw/dds/ports.hpp"
+#include "bbw/dds/receive_runner.hpp"
 #include "bbw/dds/run_id.hpp"
 #include "bbw/dds/topics.hpp"
 #include "bbw/node/corner_node.hpp"
@@ -79,50 +80,83 @@ class VehicleApp {
               " ms (sensor readers matched " + std::to_string(sensors_.peers()) + " of 5)";
       return kExitDiscovery;
     }
-    const std::uint64_t periods = node::periods_of(scenario_.corners.scenario);
-    const std::size_t n = static_cast<std::size_t>(node::steps_per_period(scenario_.corners.scenario));
+    periods_ = node::periods_of(scenario_.corners.scenario);
+    n_ = static_cast<std::size_t>(node::steps_per_period(scenario_.corners.scenario));
+    // The periods run on the thread that receives their last block (bbw/dds/receive_runner.hpp)
+    // until the end or a stall; then on this loop.
+    std::uint64_t k_from = 0;
+    if (dds::lockstep_on_receive()) {
+      const auto end = dds::run_on_receive(events_, [this] { return advance_on_receive(); }, [this] { return periods_done_; });
+      if (send_failed_) {
+        error = "VehicleSensors write failed at period " + std::to_string(periods_done_);
+        return kExitRuntime;
+      }
+      k_from = end == dds::ReceiveRunEnd::Interrupted ? periods_ : periods_done_;
+    }
     runtime::LockstepClock period_clock(events_, options_.peer_timeout);
-    period_clock.start(0);
-    for (std::uint64_t k = 0; k < periods && !events_.interrupted(); ++k) {
-      std::array<bool, 4> have{};
+    period_clock.start(k_from);
+    for (std::uint64_t k = k_from; k < periods_ && !events_.interrupted(); ++k) {
       // Lockstep only: the clock policy of bbw/runtime/period_clock.hpp.
-      const runtime::PeriodStart begun = period_clock.begin(k, [&] {
-        for (std::size_t slot = 0; slot < 4; ++slot) {
-          transport::EndpointId from = 0;
-          while (blocks_[slot]->take(block_, from)) {
-            if (block_.run_id() != options_.participant.run_id || block_.corner_id() != slot) continue;
-            if (block_.block_seq() == k) {
-              node_.on_block(slot, block_);
-              have[slot] = true;
-            }
-          }
-          dds::QosEvent e;
-          while (blocks_[slot]->get().take_event(e)) {
-            if (e.kind == dds::QosEvent::Kind::WriterLost || e.kind == dds::QosEvent::Kind::LivelinessLost) lost_[slot] = true;
-          }
-          if (lost_[slot]) node_.corner_lost(slot);
-        }
-        bool all = true;
-        for (std::size_t slot = 0; slot < 4; ++slot) all = all && (have[slot] || lost_[slot]);
-        return all;
-      });
+      const runtime::PeriodStart begun = period_clock.begin(k, [&] { return take_blocks(k); });
       if (begun == runtime::PeriodStart::Interrupted) break;
       if (begun == runtime::PeriodStart::TimedOut) {
         error = "no measurement block for period " + std::to_string(k) + " within " +
                 std::to_string(options_.peer_timeout.count()) + " ms";
         return kExitPeerLost;
       }
-      if (!sensors_.send(node_.simulate_period(k, n))) {
+      if (!end_period(k)) {
         error = "VehicleSensors write failed at period " + std::to_string(k);
         return kExitRuntime;
       }
-      periods_done_ = k + 1;
     }
     sensors_.get().get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2, 0));
     return kExitOk;
   }
 
   const vehicle_run::VehicleNode& node() const { return node_; }
+
+  // Takes the corners' blocks of period k; true when every corner's is in (or the corner is gone).
+  bool take_blocks(std::uint64_t k) {
+    for (std::size_t slot = 0; slot < 4; ++slot) {
+      transport::EndpointId from = 0;
+      while (blocks_[slot]->take(block_, from)) {
+        if (block_.run_id() != options_.participant.run_id || block_.corner_id() != slot) continue;
+        if (block_.block_seq() == k) {
+          node_.on_block(slot, block_);
+          have_[slot] = true;
+        }
+      }
+      dds::QosEvent e;
+      while (blocks_[slot]->get().take_event(e)) {
+        if (e.kind == dds::QosEvent::Kind::WriterLost || e.kind == dds::QosEvent::Kind::LivelinessLost) lost_[slot] = true;
+      }
+      if (lost_[slot]) node_.corner_lost(slot);
+    }
+    bool all = true;
+    for (std::size_t slot = 0; slot < 4; ++slot) all = all && (have_[slot] || lost_[slot]);
+    return all;
+  }
+
+  // Integrates period k and publishes the vehicle's readings; false when the write failed.
+  bool end_period(std::uint64_t k) {
+    if (!sensors_.send(node_.simulate_period(k, n_))) return false;
+    periods_done_ = k + 1;
+    have_ = {};
+    return true;
+  }
+
+  // Every period whose blocks are in; true when run()'s loop must carry on (the end, a failed write).
+  bool advance_on_receive() {
+    for (;;) {
+      const std::uint64_t k = periods_done_;
+      if (k >= periods_ || events_.interrupted()) return true;
+      if (!take_blocks(k)) return false;
+      if (!end_period(k)) {
+        send_failed_ = true;
+        return true;
+      }
+    }
+  }
   std::uint64_t periods_done() const { return periods_done_; }
 
  private:
@@ -135,8 +169,12 @@ class VehicleApp {
   dds::DdsOutlet<msg::VehicleSensorsPubSubType> sensors_;
   std::array<std::unique_ptr<BlockInlet>, 4> blocks_;
   std::array<bool, 4> lost_{};
+  std::array<bool, 4> have_{};  // the corners' blocks of the period being waited for
   msg::MeasurementBlock block_;
+  std::uint64_t periods_ = 0;
+  std::size_t n_ = 0;           // plant steps per period
   std::uint64_t periods_done_ = 0;
+  bool send_failed_ = false;
 };
 
 std::string usage() {
