@@ -1,5 +1,7 @@
 #include "bbw/node/corner_node.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -140,6 +142,7 @@ void CornerNode::on_calibration(const msg::CalibrationState& state) {
     ++stats_.calibrations_rejected;  // another run's
     return;
   }
+  calibration_seen_ = std::max(calibration_seen_, static_cast<std::uint64_t>(state.version()));
   if (state.version() < model_.version && friction_.started()) return;  // stale
   // Decoded into a spare model sized at construction, then swapped in: no allocation per model.
   if (!dds::from_msg(state, candidate_)) {

@@ -126,8 +126,14 @@ class CornerNode {
   const corner::CommandGate& gate() const { return gate_; }
   bool have_command() const { return have_command_; }
   const msg::ClampCommand& latest_command() const { return latest_command_; }
-  // Lockstep: the command for period k (the grant to simulate it) or a stop is held.
-  bool granted(std::uint64_t k) const { return latest_command_.step() >= k || latest_command_.stop(); }
+  // Lockstep: the command for period k (the grant to simulate it) or a stop is held, and the
+  // calibration state that command names (ClampCommand.calibration_version) has arrived: the two
+  // come on separate topics, so on separate Fast DDS threads and in no fixed order, and a period
+  // simulated before its state would differ from run to run.
+  bool granted(std::uint64_t k) const {
+    return latest_command_.stop() ||
+           (latest_command_.step() >= k && calibration_seen_ >= latest_command_.calibration_version());
+  }
   bool ccu_lost() const { return ccu_lost_; }
   // The corner runs without the CCU (lost, holding or at its default force) at its current time.
   bool alone() const;
@@ -163,6 +169,7 @@ class CornerNode {
   msg::MeasurementSample sample_;
   msg::ClampCommand latest_command_;
   bool have_command_ = false;
+  std::uint64_t calibration_seen_ = 0;  // newest CalibrationState.version of this run and corner (applied or not)
   std::optional<std::uint64_t> last_command_seq_;
   std::array<std::uint8_t, 16> last_writer_{};  // of the newest command taken
   dds::CalibrationModel model_;
