@@ -161,7 +161,7 @@ int main(int argc, char** argv) {
          }},
         {"x not scaled to [-1, 1]", [](CalibratorConfig& c) { c.scale_x = false; }},
         {"K_i unconstrained (no NNLS)", [](CalibratorConfig& c) { c.nonnegative_k = false; }},
-        {"every K_i and the curve updated from any span", [](CalibratorConfig& c) { c.identify_per_element = false; c.min_cycle_span_rev = 0.0; }},
+        {"every K_i and the curve updated from any span (with friction memory: the curve only)", [](CalibratorConfig& c) { c.identify_per_element = false; c.min_cycle_span_rev = 0.0; }},
         {"even thresholds", [](CalibratorConfig& c) { c.spacing = ThresholdSpacing::Even; }},
         {"replay over stored samples (no streaming states)", [](CalibratorConfig& c) { c.streaming_states = false; }},
         {"each cycle's K_i fitted alone, then averaged (friction_memory 0)", [](CalibratorConfig& c) { c.friction_memory = 0.0; }},

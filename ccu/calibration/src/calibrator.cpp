@@ -353,7 +353,7 @@ bool Calibrator::end_cycle_with_memory() {
   for (std::size_t j = 0; j < p; ++j) {
     column_on_[j] = 1;
     column_map_[j] = static_cast<int>(j);
-    nonneg_flags_[j] = j >= kCurveTerms ? 1 : 0;
+    nonneg_flags_[j] = (j >= kCurveTerms && (nonneg_ || j >= kCurveTerms + static_cast<std::size_t>(m_))) ? 1 : 0;
   }
   if (rows < p + 2) return false;
   std::fill(gram_.begin(), gram_.end(), 0.0);
