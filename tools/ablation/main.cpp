@@ -168,6 +168,7 @@ int main(int argc, char** argv) {
         {"paper's start rule eq. 6 (no hysteresis)", [](CalibratorConfig& c) { c.start_margin_rev = 0.0; }},
         {"no ridge", [](CalibratorConfig& c) { c.ridge = 0.0; }},
         {"drop rule j+1", [](CalibratorConfig& c) { c.drop_rule = DropRule::DropJPlus1; }},
+        {"+ friction memory 0.9 (issue 13 item 3; not shipped: docs/calibrator.md)", [](CalibratorConfig& c) { c.friction_memory = 0.9; }},
         {"paper mode (the published method)", [](CalibratorConfig& c) { c.mode = Mode::Paper; }},
         {"paper mode, drop rule j+1", [](CalibratorConfig& c) { c.mode = Mode::Paper; c.drop_rule = DropRule::DropJPlus1; }},
     };

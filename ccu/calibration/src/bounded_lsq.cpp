@@ -23,7 +23,7 @@ std::size_t BoundedLeastSquares::bytes() const {
 }
 
 // Solves G_PP z_P = h_P for the passive set; z is zero elsewhere.
-bool BoundedLeastSquares::solve_subset(const double* G, const double* h, int n, double* z) {
+bool BoundedLeastSquares::solve_subset(const double* G, const double* h, int n, int ld, double* z) {
   int p = 0;
   for (int j = 0; j < n; ++j) {
     if (passive_[static_cast<std::size_t>(j)]) idx_[static_cast<std::size_t>(p++)] = j;
@@ -37,7 +37,7 @@ bool BoundedLeastSquares::solve_subset(const double* G, const double* h, int n, 
     double* lr = row(r);
     for (int c = 0; c <= r; ++c) {
       const double* lc = row(c);
-      double s = G[idx_[static_cast<std::size_t>(r)] * n + idx_[static_cast<std::size_t>(c)]];
+      double s = G[idx_[static_cast<std::size_t>(r)] * ld + idx_[static_cast<std::size_t>(c)]];
       for (int k = 0; k < c; ++k) s -= lr[k] * lc[k];
       if (r == c) {
         if (!(s > 0.0) || !std::isfinite(s)) return false;
@@ -65,16 +65,18 @@ bool BoundedLeastSquares::solve_subset(const double* G, const double* h, int n, 
 bool BoundedLeastSquares::solve_unbounded(const double* G, const double* h, int n, double* theta) {
   if (n > max_) return false;
   for (int j = 0; j < n; ++j) passive_[static_cast<std::size_t>(j)] = 1;
-  return solve_subset(G, h, n, theta);
+  return solve_subset(G, h, n, n, theta);
 }
 
-bool BoundedLeastSquares::solve(const double* G, const double* h, const char* nonneg, int n, double* theta) {
+bool BoundedLeastSquares::solve(const double* G, const double* h, const char* nonneg, int n, double* theta, int ld) {
   if (n > max_) return false;
+  if (ld == 0) ld = n;
+  if (ld < n) return false;
   double* z = z_.data();
   double* w = w_.data();
   // Start: unconstrained variables free, constrained ones at zero.
   for (int j = 0; j < n; ++j) passive_[static_cast<std::size_t>(j)] = nonneg[j] ? 0 : 1;
-  if (!solve_subset(G, h, n, theta)) return false;
+  if (!solve_subset(G, h, n, ld, theta)) return false;
 
   const int max_outer = 3 * n + 10;
   for (int outer = 0; outer < max_outer; ++outer) {
@@ -83,7 +85,7 @@ bool BoundedLeastSquares::solve(const double* G, const double* h, const char* no
     double best_w = 1e-12;
     for (int j = 0; j < n; ++j) {
       double s = h[j];
-      for (int k = 0; k < n; ++k) s -= G[j * n + k] * theta[k];
+      for (int k = 0; k < n; ++k) s -= G[j * ld + k] * theta[k];
       w[j] = s;
       if (nonneg[j] && !passive_[static_cast<std::size_t>(j)] && s > best_w) {
         best_w = s;
@@ -93,7 +95,7 @@ bool BoundedLeastSquares::solve(const double* G, const double* h, const char* no
     if (best < 0) return true;  // KKT conditions hold
     passive_[static_cast<std::size_t>(best)] = 1;
     for (int inner = 0; inner < n + 2; ++inner) {
-      if (!solve_subset(G, h, n, z)) return false;
+      if (!solve_subset(G, h, n, ld, z)) return false;
       bool feasible = true;
       for (int j = 0; j < n; ++j) {
         if (nonneg[j] && passive_[static_cast<std::size_t>(j)] && z[j] <= 0.0) feasible = false;

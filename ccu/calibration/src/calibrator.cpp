@@ -135,6 +135,11 @@ Calibrator::Calibrator(const CalibratorConfig& config)
   column_on_.assign(p, 1);
   column_map_.assign(p, 0);
   nonneg_flags_.assign(p, 0);
+  if (robust_ && config.friction_memory > 0.0) {
+    const std::size_t q = m + static_cast<std::size_t>(e_);
+    info_kN_.assign(q * (q + 1) / 2, 0.0f);
+    info_rhs_kN_.assign(q, 0.0);
+  }
 }
 
 std::size_t Calibrator::state_bytes() const {
@@ -143,7 +148,7 @@ std::size_t Calibrator::state_bytes() const {
          vb(pf_x_rev_) + vb(pf_f_kN_) + vb(pf_proj_) + (store_.bytes() - sizeof(store_)) +
          (solver_.bytes() - sizeof(solver_)) + vb(element_pos_rev_) + vb(n_now_) + vb(vel_t_s_) + vb(vel_x_rev_) + 2 * position_delay_.capacity() * sizeof(double) + vb(start_pos_rev_) +
          vb(gram_) + vb(rhs_) + vb(theta_) + vb(row_) + vb(full_row_) + vb(n_replay_) + vb(pos_replay_) + vb(column_on_) +
-         vb(column_map_) + vb(nonneg_flags_) + vb(identified_) + vb(residual_kN_) + static_cast<std::size_t>(2 * config_.start_lag_n0 + 1) * sizeof(double);
+         vb(column_map_) + vb(info_kN_) + vb(info_rhs_kN_) + vb(nonneg_flags_) + vb(identified_) + vb(residual_kN_) + static_cast<std::size_t>(2 * config_.start_lag_n0 + 1) * sizeof(double);
 }
 
 void Calibrator::reset_curve(const Curve& curve) {
@@ -232,6 +237,7 @@ void Calibrator::for_each_fit_row(std::size_t columns, F&& f) {
 }
 
 bool Calibrator::end_cycle() {
+  if (robust_ && config_.friction_memory > 0.0) return end_cycle_with_memory();
   const std::size_t rows = store_.size();
   const double x_lo = store_.min_x_rev();
   const double x_hi = store_.max_x_rev();
@@ -325,6 +331,138 @@ bool Calibrator::end_cycle() {
       if (identified_[i] < 100) ++identified_[i];
     }
     if (element) friction_.stiffness_kN_per_rev[i] = phi_kN_[i] / friction_.delta_rev[i];
+    else friction_.viscous_kN_per_rev_per_s = phi_kN_[i] / config_.viscous_speed_scale_rev_per_s;
+  }
+  return true;
+}
+
+// Friction memory (config friction_memory): every column takes part; the cycle's curve
+// deviation (4 free columns) is eliminated from its normal equations, leaving the information
+// S = G_ee - G_ec G_cc^-1 G_ce and r = h_e - G_ec G_cc^-1 h_c the cycle carries on the
+// amplitudes (any cubic in the target, such as the change of the current curve, drops out).
+// The amplitudes solve (memory * S_past + S + priors) phi = memory * r_past + r, phi >= 0;
+// the curve deviation is then G_cc^-1 (h_c - G_ce phi).
+bool Calibrator::end_cycle_with_memory() {
+  const std::size_t rows = store_.size();
+  const double x_lo = store_.min_x_rev();
+  const double x_hi = store_.max_x_rev();
+  const double span = x_hi - x_lo;
+  stats_.last_fit_span_rev = span;
+  const auto p = static_cast<std::size_t>(p_);
+  const std::size_t q = p - kCurveTerms;  // amplitudes: elements, then effect columns
+  for (std::size_t j = 0; j < p; ++j) {
+    column_on_[j] = 1;
+    column_map_[j] = static_cast<int>(j);
+    nonneg_flags_[j] = (j >= kCurveTerms && (nonneg_ || j >= kCurveTerms + static_cast<std::size_t>(m_))) ? 1 : 0;
+  }
+  if (rows < p + 2) return false;
+  std::fill(gram_.begin(), gram_.end(), 0.0);
+  std::fill(rhs_.begin(), rhs_.end(), 0.0);
+  for_each_fit_row(p, [&](const double* row, double b) {
+    for (std::size_t a = 0; a < p; ++a) {
+      rhs_[a] += row[a] * b;
+      for (std::size_t c = a; c < p; ++c) gram_[a * p + c] += row[a] * row[c];
+    }
+  });
+  for (std::size_t a = 0; a < p; ++a) {
+    for (std::size_t c = 0; c < a; ++c) gram_[a * p + c] = gram_[c * p + a];
+  }
+  const double lambda = config_.ridge * static_cast<double>(rows);
+  // G_cc^-1 (4 x 4, with the ridge) by Gauss-Jordan, and h_c, kept for the curve.
+  double gcc[16], inv[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) gcc[r * 4 + c] = gram_[static_cast<std::size_t>(r) * p + static_cast<std::size_t>(c)] + (r == c ? lambda : 0.0);
+  }
+  for (int c = 0; c < 4; ++c) {
+    const double d = gcc[c * 4 + c];
+    if (!(d > 0.0) || !std::isfinite(d)) return false;
+    for (int k = 0; k < 4; ++k) {
+      gcc[c * 4 + k] /= d;
+      inv[c * 4 + k] /= d;
+    }
+    for (int r = 0; r < 4; ++r) {
+      if (r == c) continue;
+      const double f = gcc[r * 4 + c];
+      for (int k = 0; k < 4; ++k) {
+        gcc[r * 4 + k] -= f * gcc[c * 4 + k];
+        inv[r * 4 + k] -= f * inv[c * 4 + k];
+      }
+    }
+  }
+  double hc[4];
+  for (std::size_t r = 0; r < 4; ++r) hc[r] = rhs_[r];
+  // This cycle's information, in place over G_ee (upper triangle; G_ec, columns 0..3, is
+  // read and not written): S_ab = G_ee,ab - G_ec,a. G_cc^-1 G_ce,.b, and r_b likewise. Then the
+  // past information times the memory is added, and the ridge, and the lower triangle filled.
+  double* const s_block = gram_.data() + kCurveTerms * p + kCurveTerms;  // leading dimension p
+  double* const r_block = rhs_.data() + kCurveTerms;
+  const double mem = config_.friction_memory;
+  for (std::size_t b = 0; b < q; ++b) {
+    const double* g_b = gram_.data() + (kCurveTerms + b) * p;
+    double w[4];
+    for (std::size_t r = 0; r < 4; ++r) w[r] = inv[r * 4 + 0] * g_b[0] + inv[r * 4 + 1] * g_b[1] + inv[r * 4 + 2] * g_b[2] + inv[r * 4 + 3] * g_b[3];
+    for (std::size_t a = 0; a <= b; ++a) {
+      const double* g_a = gram_.data() + (kCurveTerms + a) * p;
+      s_block[a * p + b] -= g_a[0] * w[0] + g_a[1] * w[1] + g_a[2] * w[2] + g_a[3] * w[3];
+    }
+    r_block[b] -= w[0] * hc[0] + w[1] * hc[1] + w[2] * hc[2] + w[3] * hc[3];
+  }
+  std::size_t t = 0;
+  for (std::size_t a = 0; a < q; ++a) {
+    for (std::size_t b = a; b < q; ++b, ++t) s_block[a * p + b] += mem * static_cast<double>(info_kN_[t]);
+    r_block[a] += mem * info_rhs_kN_[a];
+    for (std::size_t b = 0; b < a; ++b) s_block[a * p + b] = s_block[b * p + a];
+    s_block[a * p + a] += lambda;
+  }
+  if (!solver_.solve(s_block, r_block, nonneg_flags_.data() + kCurveTerms, static_cast<int>(q), theta_.data() + kCurveTerms,
+                     static_cast<int>(p))) {
+    return false;
+  }
+  for (std::size_t a = kCurveTerms; a < p; ++a) {
+    if (!std::isfinite(theta_[a])) return false;
+  }
+  // The cycle's curve deviation given the amplitudes: G_cc^-1 (h_c - G_ce phi), G_ce phi summed
+  // over the rows.
+  double gce_phi[4] = {0, 0, 0, 0};
+  for_each_fit_row(p, [&](const double* row, double) {
+    double fr = 0.0;
+    for (std::size_t a = kCurveTerms; a < p; ++a) fr += row[a] * theta_[a];
+    for (std::size_t k = 0; k < 4; ++k) gce_phi[k] += row[k] * fr;
+  });
+  for (std::size_t r = 0; r < 4; ++r) {
+    double v = 0.0;
+    for (std::size_t k = 0; k < 4; ++k) v += inv[r * 4 + k] * (hc[k] - gce_phi[k]);
+    theta_[r] = v;
+  }
+  double sse = 0.0;
+  for_each_fit_row(p, [&](const double* row, double b) {
+    double model = 0.0;
+    for (std::size_t a = 0; a < p; ++a) model += row[a] * theta_[a];
+    sse += (b - model) * (b - model);
+  });
+  const double rms = std::sqrt(sse / static_cast<double>(rows));
+  stats_.last_fit_rms_kN = rms;
+  if (rms > config_.max_fit_rms_kN) return false;
+
+  // Accepted: keep the summed information (without the ridge), the amplitudes and the curve.
+  t = 0;
+  for (std::size_t a = 0; a < q; ++a) {
+    for (std::size_t b = a; b < q; ++b, ++t) info_kN_[t] = static_cast<float>(s_block[a * p + b] - (a == b ? lambda : 0.0));
+    info_rhs_kN_[a] = r_block[a];
+  }
+  if (span >= config_.min_cycle_span_rev) {
+    const double margin = 0.5 * (config_.x_max_rev - config_.x_min_rev) / config_.pf_points_N;
+    for (std::size_t k = 0; k < pf_x_rev_.size(); ++k) {
+      const double X = pf_x_rev_[k];
+      if (X < x_lo - margin || X > x_hi + margin) continue;
+      const double u = scaled_ ? (X - xc_rev_) / xh_rev_ : X;
+      pf_f_kN_[k] = curve_.force_kN(X) + ((theta_[3] * u + theta_[2]) * u + theta_[1]) * u + theta_[0];
+    }
+    refit_curve_from_pf();
+  }
+  for (std::size_t i = 0; i < q; ++i) {
+    phi_kN_[i] = theta_[kCurveTerms + i];
+    if (i < static_cast<std::size_t>(m_)) friction_.stiffness_kN_per_rev[i] = phi_kN_[i] / friction_.delta_rev[i];
     else friction_.viscous_kN_per_rev_per_s = phi_kN_[i] / config_.viscous_speed_scale_rev_per_s;
   }
   return true;

@@ -74,6 +74,7 @@ void CalibratorConfig::validate() const {
   if (!(min_cycle_span_rev >= 0.0)) bad("min_cycle_span_rev", min_cycle_span_rev, "must be >= 0");
   if (!(geometric_ratio > 0.0 && geometric_ratio < 1.0)) bad("geometric_ratio", geometric_ratio, "must be in (0, 1)");
   if (!(ridge >= 0.0)) bad("ridge", ridge, "must be >= 0");
+  if (!(friction_memory >= 0.0 && friction_memory <= 1.0)) bad("friction_memory", friction_memory, "must be in [0, 1]");
   if (!(max_fit_rms_kN > 0.0)) bad("max_fit_rms_kN", max_fit_rms_kN, "must be > 0");
   if (!(start_margin_rev >= 0.0)) bad("start_margin_rev", start_margin_rev, "must be >= 0");
   if (velocity_window < 2 || velocity_window > 1000) bad("velocity_window", velocity_window, "must be in [2, 1000]");

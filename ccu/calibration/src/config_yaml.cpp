@@ -58,6 +58,7 @@ CalibratorConfig read_config(Reader& r) {
     c.start_margin_rev = rb->number_or("start_margin_rev", c.start_margin_rev, Range::non_negative());
     c.k_smoothing = rb->number_or("k_smoothing", c.k_smoothing, Range{0.0, 1.0, true, false});
     c.identify_per_element = rb->boolean_or("identify_per_element", c.identify_per_element);
+    c.friction_memory = rb->number_or("friction_memory", c.friction_memory, Range{0.0, 1.0, false, false});
     c.residual_window = static_cast<int>(
         rb->integer_or("residual_window", c.residual_window, 1, CalibratorConfig::kMaxResidualWindow));
     rb->finish();

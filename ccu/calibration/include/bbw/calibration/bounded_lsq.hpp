@@ -13,9 +13,10 @@ class BoundedLeastSquares {
  public:
   explicit BoundedLeastSquares(int max_params);
 
-  // G is n x n row-major. Returns false when a sub-problem is not positive definite or the
-  // iteration limit is hit; theta is then left at the last feasible point.
-  bool solve(const double* G, const double* h, const char* nonneg, int n, double* theta);
+  // G is n x n row-major, row j starting at G + j ld (ld = 0: n; a block of a larger matrix
+  // otherwise). Returns false when a sub-problem is not positive definite or the iteration
+  // limit is hit; theta is then left at the last feasible point.
+  bool solve(const double* G, const double* h, const char* nonneg, int n, double* theta, int ld = 0);
 
   // Cholesky solve of the whole system without bounds (the paper's plain least squares).
   bool solve_unbounded(const double* G, const double* h, int n, double* theta);
@@ -23,7 +24,7 @@ class BoundedLeastSquares {
   std::size_t bytes() const;
 
  private:
-  bool solve_subset(const double* G, const double* h, int n, double* z);  // on passive_
+  bool solve_subset(const double* G, const double* h, int n, int ld, double* z);  // on passive_
 
   int max_;
   std::vector<double> l_;       // Cholesky factor workspace, lower triangle packed by rows

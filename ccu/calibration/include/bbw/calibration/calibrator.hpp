@@ -154,6 +154,11 @@ class Calibrator {
   std::vector<char> column_on_;
   std::vector<int> column_map_;
   std::vector<char> nonneg_flags_;
+  bool end_cycle_with_memory();
+  // Friction memory (config friction_memory): the summed information on the amplitudes
+  // (packed upper triangle by rows, float) and its right-hand side; empty when off.
+  std::vector<float> info_kN_;
+  std::vector<double> info_rhs_kN_;
 };
 
 }  // namespace bbw::calibration

@@ -54,6 +54,12 @@ struct CalibratorConfig {
   double start_margin_rev = 0.02;    // robust start detector hysteresis (0 = the paper's eq. 6)
   double k_smoothing = 1.0;          // weight of a new fit's friction stiffness (1 = replace)
   bool identify_per_element = true;  // update K_i only when the cycle span >= 2 Delta_i
+  // Friction memory: each cycle's information on the friction amplitudes (its normal
+  // equations with the cycle's curve deviation eliminated) is added to the past information
+  // times friction_memory, and the amplitudes are solved from the sum. A cycle then moves an
+  // element only as far as it informs it. 0 = off (each cycle fitted alone and the amplitudes
+  // averaged with k_smoothing); in (0, 1].
+  double friction_memory = 0.0;
   // Load-cell noise passes straight into f_hat = f_c - friction. The estimate is the curve at
   // the present position plus the mean of the last residual_window residuals
   // r = f_c - friction - C(x) (the curve error and friction misfit vary slowly; the noise is
