@@ -1,6 +1,7 @@
 // The calibrator's YAML loader: every shipped file loads; each kind of mistake is reported
 // with file, line, key path and rule.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <dirent.h>
 
@@ -27,7 +28,8 @@ std::string robust_text() {
 }
 
 ConfigError load_broken(const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/broken_calibrator.yaml";
+  // One file per process: ctest runs this binary's tests as parallel processes.
+  const std::string path = ::testing::TempDir() + "/broken_calibrator_" + std::to_string(::getpid()) + ".yaml";
   {
     std::ofstream f(path);
     f << text;
