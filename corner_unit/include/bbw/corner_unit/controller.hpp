@@ -48,6 +48,11 @@ struct ControllerParams {
   double stiffness_memory_rev = 0.02;
   double stiffness_reversal_rev = 2.0e-4;     // an increment this long or longer sets the direction
   double stiffness_max_ratio = 100.0;
+  // The feedback terms divide by the largest seen stiffness, forgotten with the travel
+  // (exp(-|dx| / hold_rev)): a loop that dithers across a reversal (or a backlash gap, 0.05 rev,
+  // where the slope it sees is 0 until the flank meets sticking friction) keeps the low gain the
+  // stiff side needs. The rate feedforward divides by the current estimate.
+  double stiffness_hold_rev = 0.1;
 
   void validate() const;  // throws std::invalid_argument naming the field
 };
@@ -86,7 +91,8 @@ struct StiffnessEstimate {
   double sum_xx_rev2 = 0.0;            // sum w dx^2
   double sum_xf_kN_rev = 0.0;          // sum w dx dF
   int direction = 0;                   // sign of the last increment of at least stiffness_reversal_rev
-  double stiffness_kN_per_rev = 0.0;   // the k the force loop used last (max of both)
+  double stiffness_kN_per_rev = 0.0;   // the k the rate feedforward used last (max of model and seen)
+  double held_kN_per_rev = 0.0;        // the k the feedback terms used last (the held maximum)
 };
 
 struct ControllerState {
@@ -117,8 +123,9 @@ class LocalController {
 
  private:
   ControllerOutput speed_loop(double v_ref, double a_ff, const ControllerInputs& in, double dt_s);
-  // The stiffness the force loop divides by: max(model, seen), updating the estimate.
-  double stiffness(double model_kN_per_rev, const ControllerInputs& in);
+  // Updates the estimate: s_.stiffness.stiffness_kN_per_rev (feedforward) and held_kN_per_rev
+  // (feedback), both >= the model.
+  void update_stiffness(double model_kN_per_rev, const ControllerInputs& in);
 
   ControllerParams p_;
   ControllerState s_;
