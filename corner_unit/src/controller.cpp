@@ -41,6 +41,16 @@ void ControllerParams::validate() const {
   positive("stiffness_at_zero_kN_per_rev", stiffness_at_zero_kN_per_rev);
   non_negative("stiffness_per_kN_per_rev", stiffness_per_kN_per_rev);
   non_negative("release_force_kN", release_force_kN);
+  positive("stiffness_stride_rev", stiffness_stride_rev);
+  positive("stiffness_stride_kN", stiffness_stride_kN);
+  positive("stiffness_memory_rev", stiffness_memory_rev);
+  non_negative("stiffness_reversal_rev", stiffness_reversal_rev);
+  positive("stiffness_hold_rev", stiffness_hold_rev);
+  if (!(std::isfinite(stiffness_max_ratio) && stiffness_max_ratio >= 1.0)) {
+    std::ostringstream os;
+    os << "stiffness_max_ratio = " << stiffness_max_ratio << ": must be >= 1";
+    throw std::invalid_argument(os.str());
+  }
   if (!std::isfinite(release_position_rev)) throw std::invalid_argument("release_position_rev must be finite");
 }
 
@@ -98,20 +108,57 @@ ControllerOutput LocalController::update_position(const PositionReference& ref, 
   return speed_loop(v_ref, a_ff, in, dt_s);
 }
 
+void LocalController::update_stiffness(double model_kN_per_rev, const ControllerInputs& in) {
+  StiffnessEstimate& e = s_.stiffness;
+  if (!p_.stiffness_estimate) {
+    e.stiffness_kN_per_rev = e.held_kN_per_rev = model_kN_per_rev;
+    return;
+  }
+  const double prior_rev2 = p_.stiffness_stride_rev * p_.stiffness_stride_rev;
+  if (!e.started) {
+    e = StiffnessEstimate{};
+    e.started = true;
+    e.anchor_position_rev = in.position_rev;
+    e.anchor_force_kN = in.force_feedback_kN;
+  }
+  const double dx = in.position_rev - e.anchor_position_rev;
+  const double df = in.force_feedback_kN - e.anchor_force_kN;
+  double forget_held = 1.0;
+  if (std::abs(dx) >= p_.stiffness_stride_rev || std::abs(df) >= p_.stiffness_stride_kN) {
+    const int dir = std::abs(dx) >= p_.stiffness_reversal_rev ? (dx > 0.0 ? 1 : -1) : 0;
+    if (dir != 0 && e.direction != 0 && dir != e.direction) {
+      e.sum_xx_rev2 = 0.0;  // a reversal: every friction element sticks again
+      e.sum_xf_kN_rev = 0.0;
+    }
+    if (dir != 0) e.direction = dir;
+    const double w = std::exp(-std::abs(dx) / p_.stiffness_memory_rev);
+    e.sum_xx_rev2 = w * e.sum_xx_rev2 + dx * dx;
+    e.sum_xf_kN_rev = w * e.sum_xf_kN_rev + dx * df;
+    e.anchor_position_rev = in.position_rev;
+    e.anchor_force_kN = in.force_feedback_kN;
+    forget_held = std::exp(-std::abs(dx) / p_.stiffness_hold_rev);
+  }
+  const double seen = (e.sum_xf_kN_rev + model_kN_per_rev * prior_rev2) / (e.sum_xx_rev2 + prior_rev2);
+  e.stiffness_kN_per_rev = std::clamp(seen, model_kN_per_rev, p_.stiffness_max_ratio * model_kN_per_rev);
+  e.held_kN_per_rev = std::max(e.stiffness_kN_per_rev, forget_held * e.held_kN_per_rev);
+}
+
 ControllerOutput LocalController::update_force(double force_command_kN, const ControllerInputs& in,
                                                double dt_s, double force_rate_kN_per_s) {
   if (!(dt_s > 0.0)) return ControllerOutput{};
   if (force_command_kN <= p_.release_force_kN) {
     s_.releasing = true;
     s_.force_integral_kN_s = 0.0;
+    s_.stiffness.started = false;  // a new apply starts from the nominal slope
     return update_position(PositionReference{p_.release_position_rev, 0.0, 0.0}, in, dt_s);
   }
   s_.releasing = false;
   const double e = force_command_kN - in.force_feedback_kN;
-  const double k = p_.stiffness_at_zero_kN_per_rev +
-                   p_.stiffness_per_kN_per_rev * std::max(in.force_feedback_kN, 0.0);
+  update_stiffness(p_.stiffness_at_zero_kN_per_rev + p_.stiffness_per_kN_per_rev * std::max(in.force_feedback_kN, 0.0),
+                   in);
   const double unclipped =
-      (force_rate_kN_per_s + p_.force_bandwidth_rad_per_s * e + p_.force_integral_rad_per_s2 * s_.force_integral_kN_s) / k;
+      force_rate_kN_per_s / s_.stiffness.stiffness_kN_per_rev +
+      (p_.force_bandwidth_rad_per_s * e + p_.force_integral_rad_per_s2 * s_.force_integral_kN_s) / s_.stiffness.held_kN_per_rev;
   const double v_ref = std::clamp(unclipped, -p_.max_speed_rev_per_s, p_.max_speed_rev_per_s);
   ControllerOutput out = speed_loop(v_ref, 0.0, in, dt_s);
   const bool clipped = v_ref != unclipped || out.saturated;

@@ -165,6 +165,13 @@ corner_unit::ControllerParams read_controller(Reader& c) {
   p.release_force_kN = c.number_or("release_force_kN", p.release_force_kN, Range::closed(0.0, 10.0));
   p.release_position_rev = c.number_or("release_position_rev", p.release_position_rev, Range::closed(-2.0, 12.0));
   p.load_feedforward = c.boolean_or("load_feedforward", p.load_feedforward);
+  p.stiffness_estimate = c.boolean_or("stiffness_estimate", p.stiffness_estimate);
+  p.stiffness_stride_rev = c.number_or("stiffness_stride_rev", p.stiffness_stride_rev, Range::positive());
+  p.stiffness_stride_kN = c.number_or("stiffness_stride_kN", p.stiffness_stride_kN, Range::positive());
+  p.stiffness_memory_rev = c.number_or("stiffness_memory_rev", p.stiffness_memory_rev, Range::positive());
+  p.stiffness_reversal_rev = c.number_or("stiffness_reversal_rev", p.stiffness_reversal_rev, Range::non_negative());
+  p.stiffness_hold_rev = c.number_or("stiffness_hold_rev", p.stiffness_hold_rev, Range::positive());
+  p.stiffness_max_ratio = c.number_or("stiffness_max_ratio", p.stiffness_max_ratio, Range::closed(1.0, 1.0e4));
   c.finish();
   return p;
 }

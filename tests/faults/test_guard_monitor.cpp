@@ -324,3 +324,24 @@ TEST(LastGoodCalibration, GivesTheNewestSnapshotBeforeATime) {
   EXPECT_DOUBLE_EQ(g.newest().curve.d, 6.0);
   EXPECT_FALSE(g.before(2.5).from_fit);  // older than the ring holds: the initial state
 }
+
+// A frozen resolver repeats its last speed exactly (a real one carries noise): its acceleration
+// reads 0 while the motor works against the loop's reaction, so the torque balance is not checked
+// (issue 14: the shipped resolver_stuck scenario's balance named a lost actuator 3 ms before the
+// stuck rule named the resolver). The same current with a speed that varies is a lost actuator.
+TEST(FaultMonitor, AFrozenResolverSpeedSuspendsTheTorqueBalance) {
+  MonitorParams p;
+  SampleCheck ok;
+  auto run = [&](bool frozen) {
+    FaultMonitor m(p, Target::FL);
+    for (int k = 1; k < 200; ++k) {
+      auto r = at(k, 0.001 * k, 4.0, 20.0);
+      r.speed_rev_per_s = frozen ? 6.045 : 6.045 + 1e-3 * (k % 3);
+      r.motor_current_A = 20.0 * p.Nm_per_kN / (p.torque_per_A_Nm * 0.1);
+      m.update(r, ok, nullptr, 20.0, r.time_s);
+    }
+    return m.diagnosis(Part::Actuator);
+  };
+  EXPECT_FALSE(run(true).present);
+  EXPECT_EQ(run(false).finding, Finding::ActuatorLost);
+}

@@ -10,7 +10,10 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, const Monito
   const CornerReading& r = c.r;
   const double t = r.time_s;
   const double accel = c.have_prev && c.dt_s > 0.0 ? (r.speed_rev_per_s - c.prev.speed_rev_per_s) / c.dt_s : 0.0;
-  if (!a.ok(Part::Resolver) || !std::isfinite(load_kN)) {
+  // A frozen resolver repeats its last (noisy, so nonzero) speed exactly.
+  const bool repeated = c.have_prev && r.speed_rev_per_s != 0.0 && r.speed_rev_per_s == c.prev.speed_rev_per_s;
+  speed_repeats_ = repeated ? speed_repeats_ + 1 : 0;
+  if (!a.ok(Part::Resolver) || !std::isfinite(load_kN) || speed_repeats_ >= p.frozen_attribution_samples) {
     torque_init_ = torque_suspect_ = lost_suspect_ = false;
     return;
   }

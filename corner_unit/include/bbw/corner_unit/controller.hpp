@@ -2,9 +2,13 @@
 // motor current command, with a current limit and anti-windup. Pure: time is an argument.
 //
 //   position mode: v_ref = v_ff + Kx (x_ref - x)                          (test rig)
-//   force mode:    v_ref = (dF_ref/dt + wf e + wi * integral(e)) / k(F),  e = F_ref - F_fb,
-//                  k(F) = stiffness_at_zero + stiffness_per_kN * F      (vehicle)
-//                  below release_force_kN the controller returns to release_position_rev.
+//   force mode:    v_ref = (dF_ref/dt + wf e + wi * integral(e)) / k,  e = F_ref - F_fb,
+//                  k = max(k(F), k_seen)                                 (vehicle)
+//                  k(F) = stiffness_at_zero + stiffness_per_kN * F: the nominal curve's slope;
+//                  k_seen: the slope the feedback shows against position over the recent travel
+//                  (StiffnessEstimate): key friction that sticks after a reversal makes the load
+//                  cell 10-100x stiffer than the curve, and a loop gain wf/k(F) then limit-cycles
+//                  (issue 14); below release_force_kN the controller returns to release_position_rev.
 //   speed loop:    i = Kv (v_ref - v) + Ki integral(v_ref - v) + i_load(F_load) + i_acc(a_ff)
 //   the command is clipped to +/- current_limit_A; integrators stop while clipped in the
 //   direction of the error (conditional integration).
@@ -33,6 +37,22 @@ struct ControllerParams {
   double release_force_kN = 0.1;
   double release_position_rev = 0.0;
   bool load_feedforward = true;
+  // The force loop's stiffness seen in its own feedback (k_seen above). An increment of the
+  // regression closes when the position has moved stride_rev or the feedback stride_kN since the
+  // last one; increments are forgotten with the travel (exp(-|dx| / memory_rev): the key friction
+  // is rate independent) and all at once at a reversal of the motion (every friction element
+  // sticks again); the nominal slope counts as one stride of prior data; k_seen <= max_ratio k(F).
+  bool stiffness_estimate = true;
+  double stiffness_stride_rev = 0.002;
+  double stiffness_stride_kN = 0.3;
+  double stiffness_memory_rev = 0.02;
+  double stiffness_reversal_rev = 2.0e-4;     // an increment this long or longer sets the direction
+  double stiffness_max_ratio = 100.0;
+  // The feedback terms divide by the largest seen stiffness, forgotten with the travel
+  // (exp(-|dx| / hold_rev)): a loop that dithers across a reversal (or a backlash gap, 0.05 rev,
+  // where the slope it sees is 0 until the flank meets sticking friction) keeps the low gain the
+  // stiff side needs. The rate feedforward divides by the current estimate.
+  double stiffness_hold_rev = 0.1;
 
   void validate() const;  // throws std::invalid_argument naming the field
 };
@@ -63,10 +83,23 @@ struct ControllerInputs {
   double load_force_kN = 0.0;          // axial load for the current feedforward (load cell)
 };
 
+// The regression of feedback force on position behind k_seen (sums weighted by the travel).
+struct StiffnessEstimate {
+  bool started = false;
+  double anchor_position_rev = 0.0;    // where the open increment began
+  double anchor_force_kN = 0.0;
+  double sum_xx_rev2 = 0.0;            // sum w dx^2
+  double sum_xf_kN_rev = 0.0;          // sum w dx dF
+  int direction = 0;                   // sign of the last increment of at least stiffness_reversal_rev
+  double stiffness_kN_per_rev = 0.0;   // the k the rate feedforward used last (max of model and seen)
+  double held_kN_per_rev = 0.0;        // the k the feedback terms used last (the held maximum)
+};
+
 struct ControllerState {
   double speed_integral_A = 0.0;
   double force_integral_kN_s = 0.0;
   bool releasing = true;               // force mode below release_force_kN
+  StiffnessEstimate stiffness;
 };
 
 struct ControllerOutput {
@@ -90,6 +123,9 @@ class LocalController {
 
  private:
   ControllerOutput speed_loop(double v_ref, double a_ff, const ControllerInputs& in, double dt_s);
+  // Updates the estimate: s_.stiffness.stiffness_kN_per_rev (feedforward) and held_kN_per_rev
+  // (feedback), both >= the model.
+  void update_stiffness(double model_kN_per_rev, const ControllerInputs& in);
 
   ControllerParams p_;
   ControllerState s_;

@@ -2,7 +2,10 @@
 // load * Nm_per_kN + J 2 pi a, against the torque the measured current should make,
 // i * torque_per_A; both low-pass filtered, their ratio is the delivered torque fraction. Below
 // torque_lost_threshold at any speed: ActuatorLost; below torque_fraction_threshold at
-// standstill: ActuatorTorqueLoss. Not checked while the resolver is faulty.
+// standstill: ActuatorTorqueLoss. Not checked while the resolver is faulty, nor while its speed
+// repeats exactly (and is not 0) for stuck.frozen_attribution_samples (a real speed carries noise and never does:
+// a frozen resolver's acceleration reads 0 while the motor works against the loop's reaction, and
+// the balance named a stuck resolver a lost actuator 3 ms before the stuck rule could; issue 14).
 #pragma once
 
 #include "bbw/faults/detectors/detector.hpp"
@@ -13,7 +16,10 @@ class TorqueDetector {
  public:
   // `load_kN`: the load cell while it is trusted, else the CCU's force estimate.
   void update(const SampleContext& c, double load_kN, const MonitorParams& p, DiagnosisArbiter& a);
-  void on_rejoin() { torque_init_ = torque_suspect_ = lost_suspect_ = false; }
+  void on_rejoin() {
+    torque_init_ = torque_suspect_ = lost_suspect_ = false;
+    speed_repeats_ = 0;
+  }
   double fraction() const { return fraction_; }
 
  private:
@@ -25,6 +31,7 @@ class TorqueDetector {
   double need_Nm_ = 0.0;
   double make_Nm_ = 0.0;
   double fraction_ = 1.0;
+  int speed_repeats_ = 0;  // samples whose speed equals the previous one exactly
 };
 
 }  // namespace bbw::faults

@@ -1,0 +1,48 @@
+// The local loop on population calipers, through the real node cores in memory (issue 14,
+// tools/loop_check): tuning member 13's loop limit-cycled at reversals and the fault monitor took
+// it for a noisy load cell (then the reaction's curve feedback for a lost actuator); with the
+// stiffness the loop sees in its own feedback, the fault-free holds scenario raises nothing.
+#include <gtest/gtest.h>
+
+#include "bbw/calibration/config_yaml.hpp"
+#include "bbw/faults/monitor_yaml.hpp"
+#include "bbw/faults/schedule_yaml.hpp"
+#include "bbw/loop_check/loop_check.hpp"
+#include "bbw/scenario/population.hpp"
+
+using namespace bbw;
+
+namespace {
+
+loop_check::LoopReport measure_member(int member, bool stiffness_estimate) {
+  auto fs = faults::load_fault_scenario(BBW_TEST_SOURCE_DIR "/config/scenarios/tuning/loop_holds.yaml");
+  const auto pop = scenario::load_population_spec(BBW_TEST_SOURCE_DIR "/config/population/tuning.yaml");
+  fs.scenario.plant = scenario::population_member(pop, member).params;
+  fs.scenario.controller.stiffness_estimate = stiffness_estimate;
+  const auto calibrator = calibration::load_config(BBW_TEST_SOURCE_DIR "/config/calibrator/robust.yaml");
+  const auto monitor = faults::load_monitor_params(BBW_TEST_SOURCE_DIR "/config/faults/monitor.yaml");
+  return loop_check::measure(fs.scenario, calibrator, monitor);
+}
+
+std::string findings(const loop_check::LoopReport& r) {
+  std::string s;
+  for (const auto& c : r.corners) {
+    for (const auto& f : c.findings) s += c.corner + " " + f + "; ";
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST(LoopCheck, TuningMember13RaisesNothingFaultFree) {
+  const auto with = measure_member(13, true);
+  EXPECT_EQ(with.findings(), 0u) << findings(with);
+  for (const auto& c : with.corners) {
+    EXPECT_GT(c.hold_s, 9.0) << c.corner;              // every hold counted: nothing took the corner out
+    EXPECT_LT(c.current_hp_rms_A, 3.0) << c.corner;    // no current limit cycle
+    EXPECT_LT(c.load_cell_step_kN, 0.3) << c.corner;   // no kN steps of the load cell
+  }
+  // Without it, the same run raised load_cell_noisy on every corner (what the fix is for).
+  const auto without = measure_member(13, false);
+  EXPECT_GE(without.findings(), 4u) << findings(without);
+}
