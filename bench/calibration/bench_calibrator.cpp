@@ -24,10 +24,16 @@ const Recording& recording() {
 // optional viscous term (speed from the position slope: the recording has no speed channel),
 // 4: robust with a 0.05 rev backlash term, 5: robust with the load-dependent friction term.
 // Variants 0-5 run at the paper's size (M = 8, L = 64: the robust row before issue 13);
-// 6: config/calibrator/robust.yaml exactly as shipped (its own M and L).
+// 6: config/calibrator/robust.yaml exactly as shipped (its own M and L); 7: the same without the
+// friction memory (issue 13's last change). Variants 0-5 keep the memory off: the rows before it.
 CalibratorConfig config(int variant) {
-  if (variant == 6) return load_config(std::string(BBW_SOURCE_DIR) + "/config/calibrator/robust.yaml");
+  if (variant == 6 || variant == 7) {
+    auto c = load_config(std::string(BBW_SOURCE_DIR) + "/config/calibrator/robust.yaml");
+    if (variant == 7) c.friction_memory = 0.0;
+    return c;
+  }
   auto c = load_config(std::string(BBW_SOURCE_DIR) + "/config/calibrator/robust.yaml");
+  c.friction_memory = 0.0;
   c.mode = variant == 1 ? Mode::Paper : Mode::Robust;
   if (variant == 2) c.force_delay_s = 0.005;
   if (variant == 3) c.viscous_friction = true;
@@ -49,6 +55,7 @@ const char* variant_label(int variant, const Calibrator& cal) {
     case 4: return "robust+backlash";
     case 5: return "robust+load_friction";
     case 6: return "robust as shipped";
+    case 7: return "robust as shipped, memory off";
     default: return to_string(cal.config().mode);
   }
 }
@@ -74,7 +81,7 @@ void BM_CalibratorUpdate(benchmark::State& state) {
   state.counters["state_bytes"] = static_cast<double>(cal.state_bytes());
   state.SetLabel(variant_label(variant, cal));
 }
-BENCHMARK(BM_CalibratorUpdate)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4)->Arg(5)->Arg(6);
+BENCHMARK(BM_CalibratorUpdate)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4)->Arg(5)->Arg(6)->Arg(7);
 
 // Cost of the one update() that ends a cycle (the fit, PF update and global refit): the
 // samples of each cycle are fed with the timer paused, the cycle-ending sample is timed.
@@ -113,6 +120,6 @@ void BM_CycleEndFit(benchmark::State& state) {
   state.counters["fit_ran"] = static_cast<double>(cal.stats().fits_accepted + cal.stats().fits_rejected - fits_before);
   state.SetLabel(variant_label(variant, cal));
 }
-BENCHMARK(BM_CycleEndFit)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4)->Arg(5)->Arg(6)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_CycleEndFit)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Arg(4)->Arg(5)->Arg(6)->Arg(7)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Issue 13: the shipped robust config on the scoring population (config/population/scoring.yaml),
 // calipers it was not tuned on (settings were chosen on config/population/tuning.yaml, another
-// seed). Every member x temperature must meet the paper's 0.27 kN after the first accepted fit.
+// seed). Every member x temperature must meet the paper's 0.27 kN after the first accepted fit and
+// an RMS of 0.04 kN.
 // The same figures: ./bbw ablation --population config/population/scoring.yaml --distribution
 #include <gtest/gtest.h>
 
@@ -43,6 +44,7 @@ TEST(CalibratorPopulation, ScoringPopulationEveryRecordingWithinPaperBound) {
       ASSERT_GT(r.stats.fits_accepted, 0u) << name;
       EXPECT_GT(r.score.samples_scored, 20000u) << name;
       EXPECT_LE(r.score.max_abs_error_kN, 0.27) << name << " at " << r.score.time_of_max_error_s << " s";
+      EXPECT_LE(r.score.rms_error_kN, 0.04) << name;  // issue 13: RMS per recording
       worst.push_back(r.score.max_abs_error_kN);
       rms_sum += r.score.rms_error_kN;
       if (r.score.max_abs_error_kN > worst_kN) {
@@ -58,4 +60,26 @@ TEST(CalibratorPopulation, ScoringPopulationEveryRecordingWithinPaperBound) {
               rms_sum / static_cast<double>(worst.size()));
   EXPECT_LE(rms_sum / static_cast<double>(worst.size()), 0.04);  // mean RMS over the recordings
   RecordProperty("worst_kN", std::to_string(worst_kN));
+}
+
+// Issue 13's friction memory (docs/calibrator.md, robust item 9), on the tuning-population
+// recording the change was traced on (c7_T54: its first cycles gave 0.10 kN to 0.53 and 0.8 rev
+// elements the caliper does not have, carried afterwards through the local loops): without the
+// memory its RMS is above 0.04 kN, with the shipped 0.9 below, and the worst error is no larger.
+TEST(CalibratorPopulation, FrictionMemoryKeepsWhatTheWideCyclesSaid) {
+  auto with = load_config(source_path("config/calibrator/robust.yaml"));
+  ASSERT_GT(with.friction_memory, 0.0);
+  auto without = with;
+  without.friction_memory = 0.0;
+  const auto spec = bbw::scenario::load_population_spec(source_path("config/population/tuning.yaml"));
+  const auto sc = bbw::scenario::population_scenario(spec, 7);
+  ASSERT_EQ(sc.corners.size(), 3u);
+  const auto rec = record_corner(sc, 2);  // 54 C
+  const auto a = run_recording(without, rec);
+  const auto b = run_recording(with, rec);
+  ASSERT_GT(a.stats.fits_accepted, 0u);
+  ASSERT_GT(b.stats.fits_accepted, 0u);
+  EXPECT_GT(a.score.rms_error_kN, 0.04);
+  EXPECT_LE(b.score.rms_error_kN, 0.04);
+  EXPECT_LE(b.score.max_abs_error_kN, a.score.max_abs_error_kN);
 }
