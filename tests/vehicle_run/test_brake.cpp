@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "bbw/brake/brake_controller.hpp"
 
@@ -197,4 +198,41 @@ TEST(BrakeController, TheHighSideIsReleasedAsTheDriverCounterSteers) {
   // Steering towards the high side releases nothing; without the gain nothing either.
   EXPECT_LE(split_run(-0.02, 25000.0).torque_Nm[1], none.torque_Nm[1] + 1.0);
   EXPECT_NEAR(split_run(0.02, 0.0).torque_Nm[1], none.torque_Nm[1], 60.0);
+}
+
+namespace {
+// The end of a low-mu stop at full pedal: the estimate stands above the car (3.3 m/s) while the
+// wheels roll at the car's 2.5 m/s (ax -0.1 m/s^2: next to no braking).
+BrakeOutput rolling_run(double free_rolling_s) {
+  BrakeControlParams p;
+  p.speed.free_rolling_s = free_rolling_s;
+  BrakeController b(p);
+  BrakeMeasurements m;
+  m.pedal_travel_mm = p.pedal.full_travel_mm;
+  m.pedal_force_N = p.pedal.full_force_N;
+  for (double& w : m.wheel_rad_s) w = 3.3 / 0.344;
+  m.ax_m_s2 = -0.1;
+  b.update(0.005, m);
+  for (double& w : m.wheel_rad_s) w = 2.5 / 0.344;
+  for (int i = 0; i < 400; ++i) b.update(0.005, m);
+  return b.last();
+}
+}  // namespace
+
+// An estimate that assumed every wheel held at the slip controllers' slip stayed above the car
+// once they had released every wheel: the wheels rolled at the car's speed, looked 20 % slipped
+// and stayed released (split-mu stop, 2.1 m/s for the last 2 s with no brake on). A wheel unbraked
+// for free_rolling_s reads the car's speed.
+TEST(BrakeController, AWheelUnbrakedForAWhileReadsTheCarsSpeed) {
+  const BrakeOutput fixed = rolling_run(0.5);
+  EXPECT_NEAR(fixed.speed_estimate_m_s, 2.5, 0.1);
+  double torque = 0.0;
+  for (double t : fixed.torque_Nm) torque += t;
+  EXPECT_GT(torque, 500.0) << "the brakes came back";
+  const BrakeOutput never = rolling_run(1e9);  // every wheel taken as held at a slip
+  EXPECT_GT(never.speed_estimate_m_s, 2.6);
+  double torque_never = 0.0;
+  for (double t : never.torque_Nm) torque_never += t;
+  std::printf("estimate %.3f / %.3f m/s, torque %.0f / %.0f N m\n", fixed.speed_estimate_m_s, never.speed_estimate_m_s, torque,
+              torque_never);
 }

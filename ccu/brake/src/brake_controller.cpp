@@ -93,7 +93,15 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
     if (s.last().active) held_slip = std::min(held_slip, s.target_slip());
   }
   if (!any_active) held_slip = 0.0;
-  const double v = speed_.update(dt_s, m.wheel_rad_s, m.ax_m_s2, any_active || z_request > 0.3, held_slip);
+  // The estimate follows the fastest wheel; it is held at a slip only if it is braked (its command
+  // of the last period above the free-rolling torque): an unbraked wheel reads the car's speed.
+  const std::size_t fastest =
+      static_cast<std::size_t>(std::max_element(m.wheel_rad_s.begin(), m.wheel_rad_s.end()) - m.wheel_rad_s.begin());
+  for (std::size_t i = 0; i < 4; ++i) {
+    unbraked_s_[i] = out_.torque_Nm[i] > p_.speed.free_rolling_torque_Nm ? 0.0 : unbraked_s_[i] + dt_s;
+  }
+  const bool fastest_braked = unbraked_s_[fastest] < p_.speed.free_rolling_s;
+  const double v = speed_.update(dt_s, m.wheel_rad_s, m.ax_m_s2, (any_active || z_request > 0.3) && fastest_braked, held_slip);
   out_.speed_estimate_m_s = v;
   // Load transfer at the measured deceleration (never more than requested).
   ax_filt_ += std::min(1.0, dt_s / 0.03) * (m.ax_m_s2 - ax_filt_);

@@ -41,6 +41,12 @@ struct SpeedEstimatorParams {
   // dropout (the wheel-speed sensor reads 0 until its first tooth), not the car.
   double bias_max_wheel_accel_m_s2 = 15.0;
   double wheel_filter_s = 0.005;
+  // The fastest wheel is held at a slip only while it is braked: commanded at or below this torque
+  // for free_rolling_s (time for a released wheel to spin up to the car's speed, on ice too) it
+  // rolls freely and reads the car's speed (an estimate that assumed a held slip on an unbraked
+  // wheel stayed above the car and the slip controllers released every wheel).
+  double free_rolling_torque_Nm = 30.0;
+  double free_rolling_s = 0.5;
 };
 
 struct SlipControlParams {
