@@ -452,6 +452,13 @@ int cmd_report(const std::string& dir) {
             << fmt(all.n ? 100.0 * all.detected / all.n : 0.0, 2) << " %), false alarms " << ff_alarms << " in " << fmt(ff_hours, 2)
             << " h fault-free (+" << faulty_run_alarms << " in faulty runs), " << failed << " failed runs; " << dir
             << "/campaign.json, " << dir << "/report.html\n";
+  if (missing > 0) {
+    // A campaign whose runs did not all leave a result is not a result (GNU parallel can end with
+    // status 0 having run nothing, e.g. on a remote host without $SHELL): say so, and fail.
+    std::cerr << "bbw_campaign: " << spec.name << ": " << missing << " of " << spec.runs
+              << " runs have no result; the figures above cover only the others (rerun the same command to resume)\n";
+    return 1;
+  }
   return 0;
 }
 
