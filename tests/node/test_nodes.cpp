@@ -164,6 +164,36 @@ TEST(CcuNode, TheBarrierWaitsForEveryCornerUnlessItsWriterIsGone) {
   EXPECT_EQ(ccu.channel(last).liveliness_lost, 1u);
 }
 
+// The realtime end (bbw_ccu waits, bounded, until this is true): a corner whose blocks came late
+// beyond their deadline (a network finding, as on a loaded machine) is still sending and is waited
+// for until its last block; a corner whose writer is gone is not. Before, the late corner was not
+// waited for and its last blocks went unreceived (SystemHostileInput.MalformedMeasurements... in CI).
+TEST(CcuNode, TheRealtimeEndWaitsForALateCornerButNotForALostOne) {
+  const auto fs = load("config/scenarios/vehicle_stop.yaml");
+  CcuNode ccu(fs.scenario, test::robust_config(), true);
+  const std::uint64_t last_block = ccu.periods() - 1;
+  msg::MeasurementBlock b;
+  b.block_seq(0);
+  for (std::size_t i = 0; i < ccu.channels(); ++i) {
+    b.corner_id(static_cast<std::uint8_t>(ccu.channel(i).slot));
+    ccu.on_block(i, b, 10 + i, 0.005);
+  }
+  EXPECT_FALSE(ccu.all_linked_finished());
+  // Corner 0 is late (deadline missed: link_lost), corner 1's writer is gone; the others finish.
+  ccu.on_deadline_missed(0, 0.5, false);
+  ASSERT_FALSE(ccu.core().supervisor(ccu.channel(0).slot).monitor().ok(faults::Part::Network));
+  ccu.on_writer_lost(1, 11, 0.5, false);
+  b.block_seq(last_block);
+  for (std::size_t i = 2; i < ccu.channels(); ++i) {
+    b.corner_id(static_cast<std::uint8_t>(ccu.channel(i).slot));
+    ccu.on_block(i, b, 10 + i, 0.6);
+  }
+  EXPECT_FALSE(ccu.all_linked_finished()) << "the late corner is still sending: its last block is waited for";
+  b.corner_id(static_cast<std::uint8_t>(ccu.channel(0).slot));
+  ccu.on_block(0, b, 10, 0.7);
+  EXPECT_TRUE(ccu.all_linked_finished()) << "the lost corner is not waited for";
+}
+
 TEST(CcuNode, CommandsCarryTheCalibratorsFrictionEstimate) {
   const auto fs = load("config/scenarios/four_corner_rig.yaml");
   CcuNode ccu(fs.scenario, test::robust_config(), true);

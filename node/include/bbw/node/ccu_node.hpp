@@ -150,7 +150,8 @@ class CcuNode {
   // lost (LivelinessLost at t_end). Returns the name of a corner that reported failure, or "".
   std::string end_lockstep_period(std::uint64_t k, double t_end_s);
   std::string lagging(std::uint64_t k) const { return barrier_.lagging(k); }
-  // Realtime end: every corner still linked has sent its last block.
+  // Realtime end: every corner whose writer is still there has sent its last block (a corner
+  // with a network finding, e.g. late under load, is still waited for; a lost writer is not).
   bool all_linked_finished() const;
 
   std::size_t channels() const { return channels_.size(); }
