@@ -14,61 +14,40 @@
 #include <memory>
 #include <string>
 
-#include "bbw/calibration/config_yaml.hpp"
-#include "bbw/common/data_path.hpp"
-#include "bbw/faults/monitor_yaml.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/node/csv_log.hpp"
 #include "bbw/node/in_process.hpp"
+#include "bbw/tool_cli/tool_cli.hpp"
 
 namespace {
 
-int usage(const std::string& why) {
-  std::cerr << "bbw_inproc: " << why << "\n"
-            << "usage: bbw_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--monitor FILE] [--friction-feedback on|off]\n";
-  return 2;
-}
+constexpr const char* kUsage =
+    "usage: bbw_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--monitor FILE] [--friction-feedback on|off]\n";
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scenario_file, out_dir, calibrator_file, monitor_file;  // defaults from bbw's data (data_path.hpp)
+  bbw::tool_cli::ModelArgs args;  // defaults from bbw's data (data_path.hpp)
+  std::string out_dir;
   bbw::node::InProcessOptions options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* flag) -> std::string {
-      if (i + 1 >= argc) throw std::invalid_argument(std::string(flag) + " needs a value");
-      return argv[++i];
-    };
-    try {
-      if (a == "--out") out_dir = value("--out");
-      else if (a == "--calibrator") calibrator_file = value("--calibrator");
-      else if (a == "--monitor") monitor_file = value("--monitor");
-      else if (a == "--friction-feedback") {
-        const std::string v = value("--friction-feedback");
-        if (v != "on" && v != "off") return usage("--friction-feedback must be on or off, got '" + v + "'");
-        options.friction_feedback = v == "on";
-      } else if (a == "-h" || a == "--help") {
-        std::cout << "usage: bbw_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--monitor FILE] [--friction-feedback on|off]\n";
-        return 0;
-      } else if (!a.empty() && a[0] == '-') return usage("unknown argument '" + a + "'");
-      else if (scenario_file.empty()) scenario_file = a;
-      else return usage("one scenario only, got '" + a + "' too");
-    } catch (const std::exception& e) {
-      return usage(e.what());
-    }
-  }
-  if (scenario_file.empty()) return usage("a scenario file is required");
-  if (out_dir.empty()) return usage("--out DIR is required");
+  const auto stop = bbw::tool_cli::parse(argc, argv, "bbw_inproc", kUsage, args, [&](const std::string& a, const auto& value) {
+    if (a == "--out") out_dir = value();
+    else if (a == "--friction-feedback") {
+      const std::string v = value();
+      if (v != "on" && v != "off") throw std::invalid_argument("--friction-feedback must be on or off, got '" + v + "'");
+      options.friction_feedback = v == "on";
+    } else return false;
+    return true;
+  });
+  if (stop) return *stop;
+  if (out_dir.empty()) return bbw::tool_cli::usage_error("bbw_inproc", kUsage, "--out DIR is required");
+  const std::string& scenario_file = args.scenario;
 
   try {
     auto fs = bbw::faults::load_fault_scenario(scenario_file);
     options.schedule = fs.faults;
-    if (calibrator_file.empty()) calibrator_file = bbw::data::path("config/calibrator/robust.yaml");
-    if (monitor_file.empty()) monitor_file = bbw::data::path("config/faults/monitor.yaml");
-    auto calibrator = bbw::calibration::load_config(calibrator_file);
-    calibrator.validate();
-    options.monitor = bbw::faults::load_monitor_params(monitor_file);
+    const auto calibrator = bbw::tool_cli::load_calibrator(args);
+    options.monitor = bbw::tool_cli::load_monitor(args);
     std::error_code ec;
     std::filesystem::create_directories(out_dir, ec);
     if (ec || !std::filesystem::is_directory(out_dir)) {

@@ -16,12 +16,10 @@
 #include <optional>
 #include <string>
 
-#include "bbw/calibration/config_yaml.hpp"
-#include "bbw/common/data_path.hpp"
-#include "bbw/faults/monitor_yaml.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/scenario/population.hpp"
 #include "bbw/loop_check/loop_check.hpp"
+#include "bbw/tool_cli/tool_cli.hpp"
 
 namespace {
 
@@ -29,53 +27,34 @@ constexpr const char* kUsage =
     "usage: bbw_loop_check SCENARIO.yaml [--population SPEC.yaml [--members A-B]] [--calibrator FILE] "
     "[--monitor FILE] [--threshold-kN X]\n";
 
-int usage(const std::string& why) {
-  std::cerr << "bbw_loop_check: " << why << "\n" << kUsage;
-  return 2;
-}
+int usage(const std::string& why) { return bbw::tool_cli::usage_error("bbw_loop_check", kUsage, why); }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scenario_file, population_file, calibrator_file, monitor_file;
+  bbw::tool_cli::ModelArgs args;
+  std::string population_file;
   int first = 0, last = -1;
   double threshold_kN = 0.1;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* flag) -> std::string {
-      if (i + 1 >= argc) throw std::invalid_argument(std::string(flag) + " needs a value");
-      return argv[++i];
-    };
-    try {
-      if (a == "--population") population_file = value("--population");
-      else if (a == "--members") {
-        const std::string v = value("--members");
-        const auto dash = v.find('-');
-        first = std::stoi(v.substr(0, dash));
-        last = dash == std::string::npos ? first : std::stoi(v.substr(dash + 1));
-        if (first < 0 || last < first) return usage("--members must be A or A-B with 0 <= A <= B");
-      } else if (a == "--calibrator") calibrator_file = value("--calibrator");
-      else if (a == "--monitor") monitor_file = value("--monitor");
-      else if (a == "--threshold-kN") threshold_kN = std::stod(value("--threshold-kN"));
-      else if (a == "-h" || a == "--help") {
-        std::cout << kUsage;
-        return 0;
-      } else if (!a.empty() && a[0] == '-') return usage("unknown argument '" + a + "'");
-      else if (scenario_file.empty()) scenario_file = a;
-      else return usage("one scenario only, got '" + a + "' too");
-    } catch (const std::exception& e) {
-      return usage(e.what());
-    }
-  }
-  if (scenario_file.empty()) return usage("a scenario file is required");
+  const auto stop = bbw::tool_cli::parse(argc, argv, "bbw_loop_check", kUsage, args, [&](const std::string& a, const auto& value) {
+    if (a == "--population") population_file = value();
+    else if (a == "--members") {
+      const std::string v = value();
+      const auto dash = v.find('-');
+      first = std::stoi(v.substr(0, dash));
+      last = dash == std::string::npos ? first : std::stoi(v.substr(dash + 1));
+      if (first < 0 || last < first) throw std::invalid_argument("--members must be A or A-B with 0 <= A <= B");
+    } else if (a == "--threshold-kN") threshold_kN = std::stod(value());
+    else return false;
+    return true;
+  });
+  if (stop) return *stop;
+  const std::string& scenario_file = args.scenario;
   try {
     auto fs = bbw::faults::load_fault_scenario(scenario_file);
     if (!fs.faults.faults.empty()) throw std::invalid_argument(scenario_file + ": must be fault-free (faults: [])");
-    if (calibrator_file.empty()) calibrator_file = bbw::data::path("config/calibrator/robust.yaml");
-    if (monitor_file.empty()) monitor_file = bbw::data::path("config/faults/monitor.yaml");
-    auto calibrator = bbw::calibration::load_config(calibrator_file);
-    calibrator.validate();
-    const auto monitor = bbw::faults::load_monitor_params(monitor_file);
+    const auto calibrator = bbw::tool_cli::load_calibrator(args);
+    const auto monitor = bbw::tool_cli::load_monitor(args);
     std::optional<bbw::scenario::PopulationSpec> pop;
     if (!population_file.empty()) {
       pop = bbw::scenario::load_population_spec(population_file);

@@ -18,23 +18,20 @@
 #include <string>
 #include <vector>
 
-#include "bbw/calibration/config_yaml.hpp"
-#include "bbw/common/data_path.hpp"
 #include "bbw/common/json.hpp"
 #include "bbw/common/strict_yaml.hpp"
-#include "bbw/faults/monitor_yaml.hpp"
 #include "bbw/node/csv_log.hpp"
 #include "bbw/vehicle_run/metrics.hpp"
+#include "bbw/tool_cli/tool_cli.hpp"
 #include "bbw/vehicle_run/vehicle_run.hpp"
 
 namespace {
 
-int usage(const std::string& why) {
-  std::cerr << "bbw_vehicle_inproc: " << why << "\n"
-            << "usage: bbw_vehicle_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--monitor FILE] "
-               "[--feedback load_cell|eol_curve|compensated] [--exchange-every N] [--no-plots]\n";
-  return 2;
-}
+constexpr const char* kUsage =
+    "usage: bbw_vehicle_inproc SCENARIO.yaml --out DIR [--calibrator FILE] [--monitor FILE] "
+    "[--feedback load_cell|eol_curve|compensated] [--exchange-every N] [--no-plots]\n";
+
+int usage(const std::string& why) { return bbw::tool_cli::usage_error("bbw_vehicle_inproc", kUsage, why); }
 
 void write_csv(const std::string& file, const std::vector<bbw::vehicle_run::PeriodTrace>& tr) {
   std::ofstream f(file);
@@ -63,30 +60,20 @@ void write_csv(const std::string& file, const std::vector<bbw::vehicle_run::Peri
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scenario_file, out_dir, calibrator_file, monitor_file, feedback;
+  bbw::tool_cli::ModelArgs args;
+  std::string out_dir, feedback;
   int exchange_every = 1;
   bool want_plots = true;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* flag) -> std::string {
-      if (i + 1 >= argc) throw std::invalid_argument(std::string(flag) + " needs a value");
-      return argv[++i];
-    };
-    try {
-      if (a == "--out") out_dir = value("--out");
-      else if (a == "--calibrator") calibrator_file = value("--calibrator");
-      else if (a == "--monitor") monitor_file = value("--monitor");
-      else if (a == "--feedback") feedback = value("--feedback");
-      else if (a == "--exchange-every") exchange_every = std::stoi(value("--exchange-every"));
-      else if (a == "--no-plots") want_plots = false;
-      else if (!a.empty() && a[0] == '-') return usage("unknown argument '" + a + "'");
-      else if (scenario_file.empty()) scenario_file = a;
-      else return usage("one scenario only, got '" + a + "' too");
-    } catch (const std::exception& e) {
-      return usage(e.what());
-    }
-  }
-  if (scenario_file.empty()) return usage("a scenario file is required");
+  const auto stop = bbw::tool_cli::parse(argc, argv, "bbw_vehicle_inproc", kUsage, args, [&](const std::string& a, const auto& value) {
+    if (a == "--out") out_dir = value();
+    else if (a == "--feedback") feedback = value();
+    else if (a == "--exchange-every") exchange_every = std::stoi(value());
+    else if (a == "--no-plots") want_plots = false;
+    else return false;
+    return true;
+  });
+  if (stop) return *stop;
+  const std::string& scenario_file = args.scenario;
   if (out_dir.empty()) return usage("--out DIR is required");
   if (exchange_every < 1 || exchange_every > 64) return usage("--exchange-every must be in [1, 64]");
   if (!feedback.empty() && feedback != "load_cell" && feedback != "eol_curve" && feedback != "compensated") {
@@ -97,11 +84,8 @@ int main(int argc, char** argv) {
   bbw::vehicle_run::VehicleRunOptions options;
   try {
     scenario = bbw::vehicle_run::load_vehicle_scenario(scenario_file);
-    if (calibrator_file.empty()) calibrator_file = bbw::data::path("config/calibrator/robust.yaml");
-    if (monitor_file.empty()) monitor_file = bbw::data::path("config/faults/monitor.yaml");
-    calibrator = bbw::calibration::load_config(calibrator_file);
-    calibrator.validate();
-    options.in_process.monitor = bbw::faults::load_monitor_params(monitor_file);
+    calibrator = bbw::tool_cli::load_calibrator(args);
+    options.in_process.monitor = bbw::tool_cli::load_monitor(args);
     // The calibration study (docs/vehicle.md): (a) load_cell: the raw load cell; (b) eol_curve:
     // the end-of-line curve (the calibrator's initial curve) at the measured position;
     // (c)/(d) compensated: the load cell less the friction the CCU's calibrator (--calibrator)
