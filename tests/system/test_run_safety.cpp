@@ -307,7 +307,9 @@ TEST(SystemStops, SigintWhileKeysAreCreatedKeepsAPartialSummaryAndExits130) { st
 // Domain 206 (the killed run) and 207 (the next launch): a SIGKILLed CCU still yields a summary
 // from what the corners logged, naming the lost process; the port files and semaphores its
 // run left in /dev/shm (domain 206's ports, 7400 + 250 * 206 = 58900 and up: no other test uses
-// them) are removed by the next launch.
+// them) are removed by the next launch. It runs alone (RUN_SERIAL, tests/system/CMakeLists.txt):
+// another test's launcher starting between the dating-back below and the next launch would
+// remove the files first (seen once under ctest -j2), and this launch would find none.
 TEST(SystemStops, AKilledCcuStillYieldsASummaryAndTheNextLaunchRemovesItsSharedMemory) {
   const std::string dir = scratch("killed_ccu");
   {
