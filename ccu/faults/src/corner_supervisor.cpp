@@ -12,6 +12,15 @@ namespace {
 constexpr double kFrictionShare = 0.5;
 constexpr double kLoadFilterGain = 0.1;
 
+// The most friction a fit can give: every element saturated (the sum of K_i Delta_i).
+double friction_amplitude_kN(const calibration::FrictionParams& f) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < f.delta_rev.size() && i < f.stiffness_kN_per_rev.size(); ++i) {
+    sum += std::abs(f.stiffness_kN_per_rev[i] * f.delta_rev[i]);
+  }
+  return sum;
+}
+
 MonitorParams with_curve_range(MonitorParams p, const calibration::CalibratorConfig& c) {
   p.curve_min_rev = c.x_min_rev;
   p.curve_max_rev = c.x_max_rev;
@@ -111,6 +120,16 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
     // a turning point moved the curve by 0.75 kN and was never found).
     calibrator_->hold_fits(monitor_.residual_suspect());
     e = calibrator_->update(r);  // a CornerReading is the calibrator's Sample and more
+    if (monitor_.params().eol_curve && e.valid) {
+      // The friction the CCU uses is never more than the caliper's key friction can hold (its
+      // end-of-line width): a fit that explains more as friction (up to 7.8 kN on a 1.5 kN
+      // caliper, tuning run 7) put the estimate 4-6 kN off, which the tracking rules took for an
+      // actuator that does not release or does not track (issue 14).
+      const double hw = monitor_.params().eol_friction_half_width_kN;
+      const double bounded = std::clamp(e.friction_kN, -hw, hw);
+      e.force_kN += e.friction_kN - bounded;
+      e.friction_kN = bounded;
+    }
     const double dt_s = std::isfinite(last_fed_time_s_) ? r.time_s - last_fed_time_s_ : 0.0;
     fused_kN_ = fusion_.update(e, dt_s);
     if (e.valid) last_fed_time_s_ = r.time_s;
@@ -132,6 +151,7 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
       last_good_.push(r.time_s, *calibrator_);
       monitor_.set_curve_range(fed_min_rev_, fed_max_rev_);  // the fits had data here
       monitor_.set_fit_rms(calibrator_->stats().last_fit_rms_kN);  // its model uncertainty
+      monitor_.set_fit_friction_amplitude(friction_amplitude_kN(calibrator_->friction()));
     }
     if (monitor_.ok(Part::Resolver)) last_friction_kN_ = e.friction_kN;
   }
