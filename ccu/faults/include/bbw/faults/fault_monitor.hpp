@@ -174,8 +174,8 @@ class FaultMonitor {
   // eol_friction_amplitude_factor x the key-friction half-width the fit is not credible and the
   // residual uses the end-of-line band until a credible one.
   void set_fit_friction_amplitude(double amplitude_kN) {
-    residual_.set_fit_credible(!p_.eol_curve ||
-                               amplitude_kN <= p_.eol_friction_amplitude_factor * p_.eol_friction_half_width_kN);
+    const double hw = p_.eol_friction_half_width_kN, f = p_.eol_friction_amplitude_factor;
+    residual_.set_fit_credible(!p_.eol_curve || (amplitude_kN <= f * hw && amplitude_kN >= hw / f));
   }
   // Whether the last accepted fit was credible (true before any).
   bool fit_credible() const { return residual_.fit_credible(); }
