@@ -1,12 +1,17 @@
 // The sample guard, the fault monitor's rules on synthetic readings, and the last good state.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
+#include "bbw/calibration/config_yaml.hpp"
+#include "bbw/faults/corner_supervisor.hpp"
 #include "bbw/faults/fault_monitor.hpp"
 #include "bbw/faults/last_good.hpp"
 #include "bbw/faults/sample_guard.hpp"
+#include "bbw/plant/clamp_curve.hpp"
 #include "closed_loop.hpp"
 
 using namespace bbw::faults;
@@ -344,4 +349,112 @@ TEST(FaultMonitor, AFrozenResolverSpeedSuspendsTheTorqueBalance) {
   };
   EXPECT_FALSE(run(true).present);
   EXPECT_EQ(run(false).finding, Finding::ActuatorLost);
+}
+
+namespace {
+
+// A monitor with the caliper's end-of-line curve (as CcuCore sets it) and key-friction
+// half-width 1 kN, after 20 s of a healthy calibrated residual of 0.05 kN at 3 rev: its learnt
+// thresholds are down at the fixed 0.6 kN (issue 14).
+struct EolMonitor {
+  MonitorParams p;
+  std::optional<FaultMonitor> m;
+  SampleGuard g{MonitorParams{}.guard};
+  bbw::plant::ClampCurve eol{bbw::plant::ClampCurveParams{}};
+  std::uint64_t seq = 0;
+  double t = 0.0;
+  EolMonitor() {
+    p.eol_curve = bbw::plant::ClampCurveParams{};
+    p.eol_friction_half_width_kN = 1.0;
+    m.emplace(p, Target::FR);
+    m->set_fit_friction_amplitude(1.0);
+    for (int k = 0; k < 20000; ++k) feed(0.05);
+    m->set_fit_rms(0.05);
+  }
+  // The load cell reads the curve plus `offset_kN`; the calibrator's friction estimate is 0.
+  void feed(double offset_kN) {
+    ++seq;
+    t += 0.001;
+    const double curve_kN = eol.force_kN(3.0, p.eol_curve->reference_temperature_C, 0.0);
+    auto r = at(seq, t, 3.0, curve_kN + offset_kN);
+    const auto e = estimate(curve_kN + offset_kN, curve_kN);
+    m->update(r, g.check(r), &e, e.force_kN, t);
+  }
+};
+
+}  // namespace
+
+// A fit whose friction amplitude (the most friction it can give) is far from the caliper's
+// key-friction width explains the load cell wrongly (tuning runs: up to 5x the width on calipers
+// with viscous friction or backlash, friction estimates 4-8 kN on 1-2 kN calipers, and 0 on a 2 kN
+// one): the calibrated residual is not used with it, the end-of-line band is.
+TEST(FaultMonitor, AFitWithMoreOrLessFrictionThanTheKeysHoldIsJudgedByTheEndOfLineBand) {
+  {
+    EolMonitor credible;
+    EXPECT_TRUE(credible.m->fit_credible());
+    for (int k = 0; k < 60; ++k) credible.feed(1.2);
+    EXPECT_EQ(credible.m->diagnosis(Part::LoadCell).finding, Finding::LoadCellOffset);
+  }
+  for (double amplitude_kN : {3.0, 0.2}) {
+    EolMonitor wide;
+    wide.m->set_fit_friction_amplitude(amplitude_kN);
+    EXPECT_FALSE(wide.m->fit_credible()) << amplitude_kN;
+    for (int k = 0; k < 60; ++k) wide.feed(1.2);  // within the band: width 1 + 0.5 + 3 %
+    EXPECT_TRUE(wide.m->ok(Part::LoadCell)) << amplitude_kN;
+    EXPECT_GT(wide.m->last_residual_threshold_kN(), 1.5);
+    for (int k = 0; k < 60; ++k) wide.feed(3.0);  // beyond it
+    EXPECT_EQ(wide.m->diagnosis(Part::LoadCell).finding, Finding::LoadCellOffset) << amplitude_kN;
+  }
+  {
+    // A credible fit again: the calibrated rule is back.
+    EolMonitor again;
+    again.m->set_fit_friction_amplitude(3.0);
+    again.m->set_fit_friction_amplitude(1.4);
+    EXPECT_TRUE(again.m->fit_credible());
+    for (int k = 0; k < 60; ++k) again.feed(1.2);
+    EXPECT_EQ(again.m->diagnosis(Part::LoadCell).finding, Finding::LoadCellOffset);
+  }
+}
+
+// The friction the CCU uses (its estimate, the tracking rules' force) is never more than the
+// caliper's key friction can hold: a calibrator fitted on a load cell with 1.5 kN of friction
+// (here Coulomb, from an effect the calibrator does not model) on a caliper whose end-of-line
+// width says 0.3 kN gives at most 0.3 kN, and the estimate moves with it.
+TEST(CornerSupervisor, TheFrictionItUsesIsBoundedByTheKeyFrictionWidth) {
+  const auto cal = bbw::calibration::load_config(test::source_path("config/calibrator/robust.yaml"));
+  MonitorParams p;
+  p.eol_curve = bbw::plant::ClampCurveParams{};
+  p.eol_friction_half_width_kN = 0.3;
+  p.residual_findings = false;  // the residual is not what this is about
+  CornerSupervisor sup(cal, p, Target::FL);
+  const bbw::plant::ClampCurve curve{*p.eol_curve};
+  double max_friction_kN = 0.0;
+  int estimates = 0, off = 0;
+  std::uint64_t seq = 0;
+  for (int k = 1; k <= 20000; ++k) {
+    const double t = 0.001 * k;
+    const double x = 3.0 + 1.5 * std::sin(2.0 * M_PI * 0.5 * t);
+    const double v = 1.5 * 2.0 * M_PI * 0.5 * std::cos(2.0 * M_PI * 0.5 * t);
+    CornerReading r = at(++seq, t, x, curve.force_kN(x, 40.0, 0.0) + (v >= 0.0 ? 1.5 : -1.5));
+    r.speed_rev_per_s = v;
+    r.temperature_C = 40.0;
+    sup.on_sample(r, t);
+    const auto& e = sup.last_estimate();
+    if (!e.valid || !e.calibrated) continue;
+    max_friction_kN = std::max(max_friction_kN, std::abs(e.friction_kN));
+    // The estimate is the load cell minus that friction (the calibrator's mean over its last 4
+    // residuals lags the friction turning at a reversal by a few samples).
+    ++estimates;
+    if (std::abs(e.force_kN - (r.force_kN - e.friction_kN)) > 0.1) ++off;
+  }
+  ASSERT_GT(sup.calibrator().stats().fits_accepted, 0u);
+  EXPECT_LE(max_friction_kN, 0.3 + 1e-12);
+  EXPECT_GT(max_friction_kN, 0.29);  // it is used, up to the width
+  EXPECT_LT(off, estimates / 20) << off << " of " << estimates;  // 2 % measured
+  // The calibrator's own fit explains the 1.5 kN as friction: about 5x the width, not credible.
+  double amplitude_kN = 0.0;
+  const auto& f = sup.calibrator().friction();
+  for (std::size_t i = 0; i < f.delta_rev.size(); ++i) amplitude_kN += f.stiffness_kN_per_rev[i] * f.delta_rev[i];
+  EXPECT_GT(amplitude_kN, 1.0);
+  EXPECT_FALSE(sup.monitor().fit_credible());
 }

@@ -76,7 +76,7 @@ struct MonitorParams {
   // friction and curve are wrong by up to that much, so until a credible fit the residual is
   // held against the end-of-line band, as before the first fit (issue 14). Only with an
   // end-of-line curve.
-  double eol_friction_amplitude_factor = 1.25;
+  double eol_friction_amplitude_factor = 1.5;
   // Where the curve is trusted: the calibrator's range (CornerSupervisor copies x_min_rev and
   // x_max_rev of the calibrator config here). Outside it the cubic is an extrapolation.
   double curve_min_rev = 1.0;
