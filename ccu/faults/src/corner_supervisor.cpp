@@ -120,16 +120,6 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
     // a turning point moved the curve by 0.75 kN and was never found).
     calibrator_->hold_fits(monitor_.residual_suspect());
     e = calibrator_->update(r);  // a CornerReading is the calibrator's Sample and more
-    if (monitor_.params().eol_curve && e.valid) {
-      // The friction the CCU uses is never more than the caliper's key friction can hold (its
-      // end-of-line width): a fit that explains more as friction (up to 7.8 kN on a 1.5 kN
-      // caliper, tuning run 7) put the estimate 4-6 kN off, which the tracking rules took for an
-      // actuator that does not release or does not track (issue 14).
-      const double hw = monitor_.params().eol_friction_half_width_kN;
-      const double bounded = std::clamp(e.friction_kN, -hw, hw);
-      e.force_kN += e.friction_kN - bounded;
-      e.friction_kN = bounded;
-    }
     const double dt_s = std::isfinite(last_fed_time_s_) ? r.time_s - last_fed_time_s_ : 0.0;
     fused_kN_ = fusion_.update(e, dt_s);
     if (e.valid) last_fed_time_s_ = r.time_s;
@@ -140,9 +130,19 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
       fed_max_rev_ = std::max(fed_max_rev_, r.position_rev);
     }
   }
-  // The estimate the monitor checks tracking against: the current view's rule on this sample.
+  // The estimate the monitor checks tracking against: the current view's rule on this sample,
+  // with the calibrator's friction bounded by what the caliper's key friction can hold (its
+  // end-of-line width): a fit that explains more as friction (up to 7.8 kN on a 1.5 kN caliper,
+  // tuning run 7) put the estimate 2-6 kN off, which the tracking rules took for an actuator
+  // that does not release or does not track (issue 14). The view's estimate (the brake
+  // controller's) is left as the calibrator gives it.
   refresh_view(check.usable() ? &r : nullptr, &check, fed);
-  monitor_.update(r, check, fed, view_.force_estimate_kN, arrival_s);
+  double monitored_kN = view_.force_estimate_kN;
+  if (fed != nullptr && e.valid && view_.source == EstimateSource::Calibrator && monitor_.params().eol_curve) {
+    const double hw = monitor_.params().eol_friction_half_width_kN;
+    monitored_kN += e.friction_kN - std::clamp(e.friction_kN, -hw, hw);
+  }
+  monitor_.update(r, check, fed, monitored_kN, arrival_s);
   if (monitor_.take_rejoin()) rejoin();
   if (monitor_.take_load_cell_cleared()) resume_after_dropout();
   react_to_new_findings();
