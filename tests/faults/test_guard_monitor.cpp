@@ -1,12 +1,17 @@
 // The sample guard, the fault monitor's rules on synthetic readings, and the last good state.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
+#include "bbw/calibration/config_yaml.hpp"
+#include "bbw/faults/corner_supervisor.hpp"
 #include "bbw/faults/fault_monitor.hpp"
 #include "bbw/faults/last_good.hpp"
 #include "bbw/faults/sample_guard.hpp"
+#include "bbw/plant/clamp_curve.hpp"
 #include "closed_loop.hpp"
 
 using namespace bbw::faults;
@@ -344,4 +349,69 @@ TEST(FaultMonitor, AFrozenResolverSpeedSuspendsTheTorqueBalance) {
   };
   EXPECT_FALSE(run(true).present);
   EXPECT_EQ(run(false).finding, Finding::ActuatorLost);
+}
+
+namespace {
+
+// A monitor with the caliper's end-of-line curve (as CcuCore sets it) and key-friction
+// half-width 1 kN, after 20 s of a healthy calibrated residual of 0.05 kN at 3 rev: its learnt
+// thresholds are down at the fixed 0.6 kN (issue 14).
+struct EolMonitor {
+  MonitorParams p;
+  std::optional<FaultMonitor> m;
+  SampleGuard g{MonitorParams{}.guard};
+  bbw::plant::ClampCurve eol{bbw::plant::ClampCurveParams{}};
+  std::uint64_t seq = 0;
+  double t = 0.0;
+  EolMonitor() {
+    p.eol_curve = bbw::plant::ClampCurveParams{};
+    p.eol_friction_half_width_kN = 1.0;
+    m.emplace(p, Target::FR);
+    m->set_fit_friction_amplitude(1.0);
+    for (int k = 0; k < 20000; ++k) feed(0.05);
+    m->set_fit_rms(0.05);
+  }
+  // The load cell reads the curve plus `offset_kN`; the calibrator's friction estimate is 0.
+  void feed(double offset_kN) {
+    ++seq;
+    t += 0.001;
+    const double curve_kN = eol.force_kN(3.0, p.eol_curve->reference_temperature_C, 0.0);
+    auto r = at(seq, t, 3.0, curve_kN + offset_kN);
+    const auto e = estimate(curve_kN + offset_kN, curve_kN);
+    m->update(r, g.check(r), &e, e.force_kN, t);
+  }
+};
+
+}  // namespace
+
+// A fit whose friction amplitude (the most friction it can give) is far from the caliper's
+// key-friction width explains the load cell wrongly (tuning runs: up to 5x the width on calipers
+// with viscous friction or backlash, friction estimates 4-8 kN on 1-2 kN calipers, and 0 on a 2 kN
+// one): the calibrated residual is not used with it, the end-of-line band is.
+TEST(FaultMonitor, AFitWithMoreOrLessFrictionThanTheKeysHoldIsJudgedByTheEndOfLineBand) {
+  {
+    EolMonitor credible;
+    EXPECT_TRUE(credible.m->fit_credible());
+    for (int k = 0; k < 60; ++k) credible.feed(1.2);
+    EXPECT_EQ(credible.m->diagnosis(Part::LoadCell).finding, Finding::LoadCellOffset);
+  }
+  for (double amplitude_kN : {3.0, 0.2}) {
+    EolMonitor wide;
+    wide.m->set_fit_friction_amplitude(amplitude_kN);
+    EXPECT_FALSE(wide.m->fit_credible()) << amplitude_kN;
+    for (int k = 0; k < 60; ++k) wide.feed(1.2);  // within the band: width 1 + 0.5 + 3 %
+    EXPECT_TRUE(wide.m->ok(Part::LoadCell)) << amplitude_kN;
+    EXPECT_GT(wide.m->last_residual_threshold_kN(), 1.5);
+    for (int k = 0; k < 60; ++k) wide.feed(3.0);  // beyond it
+    EXPECT_EQ(wide.m->diagnosis(Part::LoadCell).finding, Finding::LoadCellOffset) << amplitude_kN;
+  }
+  {
+    // A credible fit again: the calibrated rule is back.
+    EolMonitor again;
+    again.m->set_fit_friction_amplitude(3.0);
+    again.m->set_fit_friction_amplitude(1.4);
+    EXPECT_TRUE(again.m->fit_credible());
+    for (int k = 0; k < 60; ++k) again.feed(1.2);
+    EXPECT_EQ(again.m->diagnosis(Part::LoadCell).finding, Finding::LoadCellOffset);
+  }
 }

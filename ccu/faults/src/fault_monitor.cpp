@@ -34,6 +34,8 @@ void MonitorParams::validate() const {
   require(std::isfinite(eol_friction_half_width_kN) && eol_friction_half_width_kN >= 0.0, "eol_friction_half_width_kN",
           eol_friction_half_width_kN, "must be >= 0");
   positive("eol_band_kN", eol_band_kN);
+  require(std::isfinite(eol_friction_amplitude_factor) && eol_friction_amplitude_factor >= 1.0,
+          "eol_friction_amplitude_factor", eol_friction_amplitude_factor, "must be >= 1");
   require(std::isfinite(eol_relative) && eol_relative >= 0.0, "eol_relative", eol_relative, "must be >= 0");
   require(std::isfinite(eol_speed_kN_per_rev_per_s) && eol_speed_kN_per_rev_per_s >= 0.0, "eol_speed_kN_per_rev_per_s",
           eol_speed_kN_per_rev_per_s, "must be >= 0");

@@ -36,6 +36,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.eol_band_kN = eol.number("band_kN", pos);
     p.eol_relative = eol.number("relative", config::Range::non_negative());
     p.eol_speed_kN_per_rev_per_s = eol.number("speed_kN_per_rev_per_s", config::Range::non_negative());
+    p.eol_friction_amplitude_factor = eol.number("friction_amplitude_factor", config::Range::at_least(1.0));
     eol.finish();
   }
   p.curve_min_rev = res.number("curve_min_rev");

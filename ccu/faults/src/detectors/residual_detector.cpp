@@ -26,13 +26,17 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // holds over the whole stroke. Without one, the calibrator's curve where the fits had data
   // (before the first fit: its initial curve against the uncalibrated threshold).
   const bool above_min = r.position_rev >= trusted_min_rev_;
-  const bool fitted_here = eol_ ? e.calibrated && above_min : r.position_rev >= curve_min_rev_ && r.position_rev <= curve_max_rev_;
+  // A fit that is not credible (more friction than the caliper's keys can hold) is no better
+  // than no fit: the end-of-line band until a credible one.
+  const bool fitted_here = eol_ ? e.calibrated && fit_credible_ && above_min
+                                : r.position_rev >= curve_min_rev_ && r.position_rev <= curve_max_rev_;
   const bool eol_here = !fitted_here && eol_ && above_min;
   if (!fitted_here && !eol_here) {
     suspect_ = false;  // no trusted curve here
     residual_kN_ = std::numeric_limits<double>::quiet_NaN();
     change_kN_ = std::numeric_limits<double>::quiet_NaN();
     threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
+    change_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
     have_reference_ = false;  // restarts where the curve is trusted again
     return;
   }
@@ -90,6 +94,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   }
   change_kN_ = residual_kN_ - reference_kN_;
   const bool change_rule = !eol_here && e.calibrated;
+  change_threshold_kN_ = change_rule ? change_thr : std::numeric_limits<double>::quiet_NaN();
   const bool over = p.residual_findings &&
                     (std::abs(residual_kN_) > thr || (change_rule && std::abs(change_kN_) > change_thr));
   if (!over && !eol_here && e.calibrated && std::isfinite(ms_residual_kN2_) && std::isfinite(change_kN_)) {

@@ -69,6 +69,14 @@ struct MonitorParams {
   double eol_band_kN = 0.5;
   double eol_relative = 0.03;
   double eol_speed_kN_per_rev_per_s = 0.3;
+  // A fit is credible when its friction amplitude (the sum of its elements' amplitudes: the most
+  // friction it can give) is at most this times the caliper's key-friction half-width. A fit
+  // beyond it explains more as friction than the caliper's keys can hold (viscous friction,
+  // backlash or a short cycle taken for friction; seen up to 5x on the tuning population): its
+  // friction and curve are wrong by up to that much, so until a credible fit the residual is
+  // held against the end-of-line band, as before the first fit (issue 14). Only with an
+  // end-of-line curve.
+  double eol_friction_amplitude_factor = 1.5;
   // Where the curve is trusted: the calibrator's range (CornerSupervisor copies x_min_rev and
   // x_max_rev of the calibrator config here). Outside it the cubic is an extrapolation.
   double curve_min_rev = 1.0;
@@ -162,10 +170,22 @@ class FaultMonitor {
   // end-of-line band covers the rest), and scales its thresholds with the fit's residual RMS.
   void set_curve_range(double min_rev, double max_rev);
   void set_fit_rms(double fit_rms_kN) { residual_.set_fit_rms(fit_rms_kN); }
+  // At an accepted fit: its friction amplitude (the most friction it can give, kN). Beyond
+  // eol_friction_amplitude_factor x the key-friction half-width the fit is not credible and the
+  // residual uses the end-of-line band until a credible one.
+  void set_fit_friction_amplitude(double amplitude_kN) {
+    const double hw = p_.eol_friction_half_width_kN, f = p_.eol_friction_amplitude_factor;
+    residual_.set_fit_credible(!p_.eol_curve || (amplitude_kN <= f * hw && amplitude_kN >= hw / f));
+  }
+  // Whether the last accepted fit was credible (true before any).
+  bool fit_credible() const { return residual_.fit_credible(); }
   // The last residual inside the curve's range (NaN outside it or before the first).
   double last_residual_kN() const { return residual_.residual_kN(); }
   // The last residual minus its reference level (NaN where the residual is).
   double last_residual_change_kN() const { return residual_.change_kN(); }
+  // The thresholds the last residual and its change were held against (NaN where none applied).
+  double last_residual_threshold_kN() const { return residual_.threshold_kN(); }
+  double last_residual_change_threshold_kN() const { return residual_.change_threshold_kN(); }
   // A residual disagreement is under way but not yet confirmed: the calibrator must not learn
   // from these samples (CornerSupervisor holds its fits).
   bool residual_suspect() const { return residual_.suspect(); }

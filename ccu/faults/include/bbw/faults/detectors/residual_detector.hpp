@@ -42,15 +42,21 @@ class ResidualDetector {
       sigma_change_kN_ = std::sqrt(ms_change_kN2_);
     }
   }
+  // Whether the calibrated residual may use the last accepted fit (FaultMonitor::set_fit_friction_amplitude).
+  void set_fit_credible(bool credible) { fit_credible_ = credible; }
+  bool fit_credible() const { return fit_credible_; }
   double residual_kN() const { return residual_kN_; }
   // The threshold the last residual was held against (kN).
   double threshold_kN() const { return threshold_kN_; }
+  // The change threshold the last change was held against (kN; NaN where there is no change rule).
+  double change_threshold_kN() const { return change_threshold_kN_; }
   // A disagreement is under way but not yet confirmed (persist_s).
   bool suspect() const { return suspect_; }
   double change_kN() const { return change_kN_; }
 
  private:
   bool suspect_ = false;
+  bool fit_credible_ = true;
   double onset_s_ = 0.0;
   double residual_kN_ = std::numeric_limits<double>::quiet_NaN();
   double change_kN_ = std::numeric_limits<double>::quiet_NaN();
@@ -63,6 +69,7 @@ class ResidualDetector {
   double trusted_min_rev_;  // the calibrator's range: below it no rule (contact, soft pads)
   double fit_rms_kN_ = 0.0;
   double threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
+  double change_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
   bool eol_mode_ = false;   // the last residual was against the end-of-line curve
   // The corner's healthy calibrated residual: mean squares of the residual and of its change
   // (low-passed over residual_stats_s, while nothing is suspected; NaN until calibrated).
