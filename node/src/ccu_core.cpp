@@ -24,6 +24,7 @@ faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, fau
   base.torque_per_A_Nm = act.torque_per_A_Nm;
   base.Nm_per_kN = act.Nm_per_kN;
   base.inertia_kg_m2 = act.inertia_kg_m2;
+  base.drive_friction_Nm = scenario.plant.transmission.coulomb_friction_Nm;
   // The caliper's end-of-line curve and key-friction width (measured on its production line):
   // the residual's reference before the first fit and beyond the fitted range (issue 14).
   base.eol_curve = scenario.plant.curve;

@@ -67,6 +67,13 @@ void MonitorParams::validate() const {
   require(torque_lost_threshold > 0.0 && torque_lost_threshold < torque_fraction_threshold, "torque_lost_threshold",
           torque_lost_threshold, "must be in (0, torque_fraction_threshold)");
   positive("torque_lost_persist_s", torque_lost_persist_s);
+  require(std::isfinite(drive_friction_Nm) && drive_friction_Nm >= 0.0, "drive_friction_Nm", drive_friction_Nm,
+          "must be >= 0");
+  positive("unexplained_margin_Nm", unexplained_margin_Nm);
+  require(std::isfinite(unexplained_relative) && unexplained_relative >= 0.0, "unexplained_relative",
+          unexplained_relative, "must be >= 0");
+  positive("unexplained_max_speed_rev_per_s", unexplained_max_speed_rev_per_s);
+  positive("unexplained_persist_s", unexplained_persist_s);
   positive("torque_check_min_load_kN", torque_check_min_load_kN);
   positive("torque_check_max_speed_rev_per_s", torque_check_max_speed_rev_per_s);
   positive("torque_persist_s", torque_persist_s);
@@ -114,7 +121,7 @@ Part part_of(Finding f) {
 }
 
 FaultMonitor::FaultMonitor(const MonitorParams& params, Target corner)
-    : p_((params.validate(), params)), corner_(corner), residual_(params) {
+    : p_((params.validate(), params)), corner_(corner), residual_(params), torque_(params) {
   if (!corner_slot(corner)) throw std::invalid_argument("FaultMonitor: monitors a corner, not the CCU");
 }
 

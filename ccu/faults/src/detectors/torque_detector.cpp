@@ -6,6 +6,10 @@
 
 namespace bbw::faults {
 
+TorqueDetector::TorqueDetector(const MonitorParams& p) {
+  if (p.eol_curve) eol_.emplace(*p.eol_curve);
+}
+
 void TorqueDetector::update(const SampleContext& c, double load_kN, const MonitorParams& p, DiagnosisArbiter& a) {
   const CornerReading& r = c.r;
   const double t = r.time_s;
@@ -14,7 +18,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, const Monito
   const bool repeated = c.have_prev && r.speed_rev_per_s != 0.0 && r.speed_rev_per_s == c.prev.speed_rev_per_s;
   speed_repeats_ = repeated ? speed_repeats_ + 1 : 0;
   if (!a.ok(Part::Resolver) || !std::isfinite(load_kN) || speed_repeats_ >= p.frozen_attribution_samples) {
-    torque_init_ = torque_suspect_ = lost_suspect_ = false;
+    torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = false;
     return;
   }
   constexpr double kTwoPi = 6.283185307179586;
@@ -40,6 +44,51 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, const Monito
     if (t - lost_onset_s_ >= p.torque_lost_persist_s) a.confirm(Finding::ActuatorLost, lost_onset_s_, t);
   } else {
     lost_suspect_ = false;
+  }
+  // Unexplained torque near standstill, at any load: the current pushes (or pulls) beyond what
+  // the load, the acceleration and the drive's friction take, and nothing moves (a seized
+  // drive) or the motor's torque goes nowhere (no torque: the load back-drives the screw). The
+  // load is the load cell's and, with an end-of-line curve, also the curve's at the measured
+  // position and temperature with the key friction's width and the curve's band: pushing, the
+  // larger of the two must not explain the torque; pulling, the smaller (a load-cell fault moves
+  // only one of them).
+  const double accel_Nm = p.inertia_kg_m2 * kTwoPi * accel;
+  double load_hi_kN = load_kN, load_lo_kN = load_kN;
+  if (eol_) {
+    const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
+    const double eol_kN = eol_->force_kN(r.position_rev, temperature_C, 0.0);
+    const double band_kN = p.eol_friction_half_width_kN + p.eol_band_kN + p.eol_relative * std::abs(eol_kN);
+    load_hi_kN = std::max(load_kN, eol_kN + band_kN);
+    load_lo_kN = std::min(load_kN, eol_kN - band_kN);
+  }
+  const double hi = load_hi_kN * p.Nm_per_kN + accel_Nm, lo = load_lo_kN * p.Nm_per_kN + accel_Nm;
+  if (!unexplained_init_ || c.dt_s <= 0.0) {
+    unexplained_init_ = true;
+    need_hi_Nm_ = hi;
+    need_lo_Nm_ = lo;
+  } else {
+    const double k = -std::expm1(-c.dt_s / p.torque_filter_s);
+    need_hi_Nm_ += (hi - need_hi_Nm_) * k;
+    need_lo_Nm_ += (lo - need_lo_Nm_) * k;
+  }
+  const double load_Nm = std::max(std::abs(load_hi_kN), std::abs(load_lo_kN)) * p.Nm_per_kN;
+  const double band = p.drive_friction_Nm + p.unexplained_margin_Nm + p.unexplained_relative * load_Nm;
+  excess_Nm_ = make_Nm_ - need_hi_Nm_;
+  const bool slow = std::abs(r.speed_rev_per_s) <= p.unexplained_max_speed_rev_per_s;
+  // Pushing: beyond the band and less than the lost threshold of it needed (a partial torque
+  // loss the loop absorbs is not a lost actuator).
+  const bool pushing = make_Nm_ - need_hi_Nm_ > band &&
+                       need_hi_Nm_ + p.drive_friction_Nm < p.torque_lost_threshold * make_Nm_;
+  // Pulling: beyond the band plus the whole load (a gear in its backlash gap carries none of it).
+  const bool pulling = need_lo_Nm_ - make_Nm_ > band + load_Nm;
+  if (slow && (pushing || pulling)) {
+    if (!unexplained_suspect_) {
+      unexplained_suspect_ = true;
+      unexplained_onset_s_ = t;
+    }
+    if (t - unexplained_onset_s_ >= p.unexplained_persist_s) a.confirm(Finding::ActuatorLost, unexplained_onset_s_, t);
+  } else {
+    unexplained_suspect_ = false;
   }
   const bool still = std::abs(r.speed_rev_per_s) <= p.torque_check_max_speed_rev_per_s;
   if (checkable && still && fraction < p.torque_fraction_threshold) {

@@ -125,6 +125,17 @@ struct MonitorParams {
   double torque_persist_s = 0.04;
   double torque_lost_threshold = 0.25;        // at any speed, below this: the actuator is lost
   double torque_lost_persist_s = 0.015;
+  // Unexplained torque (issue 14: a seized drive or a motor that makes no torque, at any load):
+  // near standstill, the measured current's torque against what the load, the acceleration and
+  // the drive's friction need. Pushing: make - need > drive_friction_Nm + unexplained_margin_Nm
+  // + unexplained_relative |need|. Pulling: need - make > the same + |need| (a gear in its
+  // backlash gap carries none of the load the load cell reads). For unexplained_persist_s:
+  // ActuatorLost.
+  double drive_friction_Nm = 0.05;            // the drive's Coulomb friction at the spindle (the plant's transmission)
+  double unexplained_margin_Nm = 0.1;
+  double unexplained_relative = 0.3;
+  double unexplained_max_speed_rev_per_s = 2.0;
+  double unexplained_persist_s = 0.03;
   // Tracking backstop: the force against a first-order model of the commanded response. A
   // shortfall below both is ActuatorTracking; an excess above both (a brake that does not
   // release) is ActuatorNotReleasing, with the same threshold and persistence.

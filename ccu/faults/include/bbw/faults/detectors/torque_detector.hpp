@@ -2,25 +2,35 @@
 // load * Nm_per_kN + J 2 pi a, against the torque the measured current should make,
 // i * torque_per_A; both low-pass filtered, their ratio is the delivered torque fraction. Below
 // torque_lost_threshold at any speed: ActuatorLost; below torque_fraction_threshold at
-// standstill: ActuatorTorqueLoss. Not checked while the resolver is faulty, nor while its speed
+// standstill: ActuatorTorqueLoss. Near standstill at any load, a made torque that neither the
+// load cell's load nor the end-of-line curve's (with its band), the acceleration and the drive's
+// friction explain, and of which less than torque_lost_threshold would be needed
+// (MonitorParams::unexplained_*): ActuatorLost. A load-cell fault moves only one of the two
+// loads, so it is not taken for the actuator's. Not checked while the resolver is faulty, nor while its speed
 // repeats exactly (and is not 0) for stuck.frozen_attribution_samples (a real speed carries noise and never does:
 // a frozen resolver's acceleration reads 0 while the motor works against the loop's reaction, and
 // the balance named a stuck resolver a lost actuator 3 ms before the stuck rule could; issue 14).
 #pragma once
 
+#include <optional>
+
 #include "bbw/faults/detectors/detector.hpp"
+#include "bbw/plant/clamp_curve.hpp"
 
 namespace bbw::faults {
 
 class TorqueDetector {
  public:
+  explicit TorqueDetector(const MonitorParams& p);
   // `load_kN`: the load cell while it is trusted, else the CCU's force estimate.
   void update(const SampleContext& c, double load_kN, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() {
-    torque_init_ = torque_suspect_ = lost_suspect_ = false;
+    torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = false;
     speed_repeats_ = 0;
   }
   double fraction() const { return fraction_; }
+  // Filtered made - needed torque at the last checked sample (the unexplained-torque rule's).
+  double excess_Nm() const { return excess_Nm_; }
 
  private:
   bool torque_suspect_ = false;
@@ -31,6 +41,13 @@ class TorqueDetector {
   double need_Nm_ = 0.0;
   double make_Nm_ = 0.0;
   double fraction_ = 1.0;
+  std::optional<plant::ClampCurve> eol_;  // the end-of-line curve: a load the load cell does not give
+  bool unexplained_init_ = false;
+  bool unexplained_suspect_ = false;
+  double need_hi_Nm_ = 0.0;  // filtered need from the larger / smaller plausible load
+  double need_lo_Nm_ = 0.0;
+  double unexplained_onset_s_ = 0.0;
+  double excess_Nm_ = 0.0;
   int speed_repeats_ = 0;  // samples whose speed equals the previous one exactly
 };
 
