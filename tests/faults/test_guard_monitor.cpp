@@ -465,3 +465,26 @@ TEST(FaultMonitor, AnUnexplainedTorqueNearStandstillIsALostActuatorAtAnyLoad) {
   auto seized_release = run(x6, f6, [&](int) { return -40.0; }, 200);
   EXPECT_EQ(seized_release.diagnosis(Part::Actuator).finding, Finding::ActuatorLost);
 }
+
+// A load-cell step while the actuator stands still (issue 14): the force cannot change, so a
+// reading that leaves the still window's level and stays is a load-cell offset, at any force and
+// without a fit (a 1 kN bias at 30 kN, where the end-of-line band is 2.4 kN wide). A noise spike
+// that returns, and the same step while the resolver is frozen (the actuator may be moving), are not.
+TEST(FaultMonitor, ALoadCellStepAtStandstillIsAnOffsetAtAnyForce) {
+  MonitorParams p;
+  SampleCheck ok;
+  auto run = [&](auto lc_kN, bool frozen) {
+    FaultMonitor m(p, Target::FR);
+    for (int k = 1; k < 300; ++k) {
+      auto r = at(k, 0.001 * k, frozen ? 4.2 : 4.2 + 2e-5 * ((k * 7) % 3), lc_kN(k));
+      r.motor_current_A = r.force_kN * p.Nm_per_kN / p.torque_per_A_Nm;
+      m.update(r, ok, nullptr, r.force_kN, r.time_s);
+    }
+    return m;
+  };
+  auto bias = run([](int k) { return 30.0 + 0.03 * ((k % 5) - 2) + (k >= 150 ? 1.0 : 0.0); }, false);
+  EXPECT_EQ(bias.diagnosis(Part::LoadCell).finding, Finding::LoadCellOffset);
+  EXPECT_NEAR(bias.diagnosis(Part::LoadCell).detected_s, 0.155, 0.002);
+  EXPECT_TRUE(run([](int k) { return 30.0 + (k == 150 ? 1.5 : 0.0); }, false).ok(Part::LoadCell));
+  EXPECT_TRUE(run([](int k) { return 30.0 + (k >= 150 ? 1.0 : 0.0); }, true).ok(Part::LoadCell));
+}

@@ -49,6 +49,15 @@ void MonitorParams::validate() const {
   require(stuck_samples >= 2, "stuck_samples", stuck_samples, "must be >= 2");
   positive("stuck_min_travel_rev", stuck_min_travel_rev);
   positive("stuck_min_force_change_kN", stuck_min_force_change_kN);
+  require(step_still_samples >= 2 && step_still_samples <= StepDetector::kMaxWindow, "step_still_samples",
+          step_still_samples, "must be in [2, 64]");
+  positive("step_still_span_rev", step_still_span_rev);
+  require(step_min_position_changes >= 1 && step_min_position_changes <= step_still_samples,
+          "step_min_position_changes", step_min_position_changes, "must be in [1, step_still_samples]");
+  positive("step_kN", step_kN);
+  require(step_keep_fraction > 0.0 && step_keep_fraction <= 1.0, "step_keep_fraction", step_keep_fraction,
+          "must be in (0, 1]");
+  require(step_confirm_samples >= 1, "step_confirm_samples", step_confirm_samples, "must be >= 1");
   require(frozen_attribution_samples >= 2, "frozen_attribution_samples", frozen_attribution_samples, "must be >= 2");
   require(noise_window_samples >= 4 && noise_window_samples <= kMaxNoiseWindow, "noise_window_samples",
           noise_window_samples, "must be in [4, 256]");
@@ -140,6 +149,7 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
     residual_.on_rejoin();
     torque_.on_rejoin();
     stuck_.on_rejoin();
+    step_.on_rejoin();
     dropout_.on_rejoin();
   }
   if (!check.usable()) return;  // corrupt: counted by the guard, never used
@@ -148,6 +158,7 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   dropout_.update(c, p_, arbiter_);
   jump_.update(c, p_, arbiter_);
   stuck_.update(c, p_, arbiter_);
+  step_.update(c, p_, arbiter_);
   if (estimate != nullptr && estimate->valid) residual_.update(r, *estimate, p_, arbiter_, noise_, stuck_, jump_);
   const double load_kN = check.load_cell_present && arbiter_.ok(Part::LoadCell) ? r.force_kN : force_estimate_kN;
   torque_.update(c, load_kN, p_, arbiter_);

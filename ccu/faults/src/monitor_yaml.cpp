@@ -58,6 +58,15 @@ MonitorParams read_monitor_params(Reader& r) {
   p.frozen_attribution_samples = static_cast<int>(s.integer("frozen_attribution_samples", 2, 100000));
   s.finish();
 
+  auto st = r.map("step");
+  p.step_still_samples = static_cast<int>(st.integer("still_samples", 2, StepDetector::kMaxWindow));
+  p.step_still_span_rev = st.number("still_span_rev", pos);
+  p.step_min_position_changes = static_cast<int>(st.integer("min_position_changes", 1, StepDetector::kMaxWindow));
+  p.step_kN = st.number("step_kN", pos);
+  p.step_keep_fraction = st.number("keep_fraction", Range{0.0, 1.0, true, false});
+  p.step_confirm_samples = static_cast<int>(st.integer("confirm_samples", 1, 1000));
+  st.finish();
+
   auto n = r.map("noise");
   p.noise_window_samples = static_cast<int>(n.integer("window_samples", 4, kMaxNoiseWindow));
   p.noise_step_kN = n.number("step_kN", pos);

@@ -28,6 +28,7 @@
 #include "bbw/faults/detectors/noise_detector.hpp"
 #include "bbw/faults/detectors/residual_detector.hpp"
 #include "bbw/faults/detectors/stuck_detector.hpp"
+#include "bbw/faults/detectors/step_detector.hpp"
 #include "bbw/faults/detectors/torque_detector.hpp"
 #include "bbw/faults/detectors/tracking_detector.hpp"
 #include "bbw/faults/finding.hpp"
@@ -97,7 +98,17 @@ struct MonitorParams {
   int stuck_samples = 20;
   double stuck_min_travel_rev = 0.05;         // position range that must move a load cell
   double stuck_min_force_change_kN = 1.0;     // load-cell range that must move a resolver
-  int frozen_attribution_samples = 5;         // repeats that name the frozen channel of a residual
+  int frozen_attribution_samples = 5;
+
+  // Load-cell step at standstill (StepDetector): the position within step_still_span_rev over
+  // step_still_samples, then the load cell off that window's mean by step_kN and beyond
+  // step_keep_fraction of it for step_confirm_samples more: LoadCellOffset.
+  int step_still_samples = 10;
+  double step_still_span_rev = 5e-4;
+  int step_min_position_changes = 3;          // in the window and the sample: a frozen resolver is not a still actuator
+  double step_kN = 0.5;
+  double step_keep_fraction = 0.6;
+  int step_confirm_samples = 5;         // repeats that name the frozen channel of a residual
 
   // Noise: in a window of the residual's sample-to-sample changes, the share larger than
   // noise_step_kN (a single step, e.g. a bias or a resolver jump, is one sample, not noise).
@@ -215,6 +226,7 @@ class FaultMonitor {
   NoiseDetector noise_;
   ResidualDetector residual_;
   TorqueDetector torque_;
+  StepDetector step_;
   TrackingDetector tracking_;
   LinkDetector link_;
   // The previous usable sample (continuity for the detectors; broken by a rejoin).
