@@ -88,14 +88,15 @@ int main(int argc, char** argv) {
     }
     std::fprintf(f, "\n  },\n  \"detections\": %zu\n}\n", run.ccu().detections().size());
     if (std::fclose(f) != 0) throw std::runtime_error(summary + ": write failed");
-    // The fault monitor's detections (as ccu.stats holds them after a DDS run), for scorers.
+    // The fault monitor's detections (as ccu.stats holds them after a DDS run, at full precision:
+    // a scorer compares them with the logs' times), for scorers.
     {
       const std::string file = out_dir + "/detections.csv";
       std::FILE* d = std::fopen(file.c_str(), "w");
       if (d == nullptr) throw std::runtime_error(file + ": cannot write");
       std::fprintf(d, "corner,finding,onset_s,detected_s\n");
       for (const auto& r : run.ccu().detections()) {
-        std::fprintf(d, "%s,%s,%.6f,%.6f\n", bbw::faults::to_string(static_cast<bbw::faults::Target>(r.slot)),
+        std::fprintf(d, "%s,%s,%.17g,%.17g\n", bbw::faults::to_string(static_cast<bbw::faults::Target>(r.slot)),
                      bbw::faults::to_string(r.finding), r.onset_s, r.detected_s);
       }
       if (std::fclose(d) != 0) throw std::runtime_error(file + ": write failed");
