@@ -29,6 +29,7 @@ faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, fau
   // the residual's reference before the first fit and beyond the fitted range (issue 14).
   base.eol_curve = scenario.plant.curve;
   base.eol_friction_half_width_kN = scenario.plant.key_friction.half_width_kN;
+  base.eol_key_friction = scenario.plant.key_friction;
   return base;
 }
 
@@ -54,6 +55,10 @@ CcuCore::CcuCore(const scenario::Scenario& scenario, const calibration::Calibrat
     faults::MonitorParams corner_mp = mp;
     corner_mp.residual_findings =
         scenario.corners[i].drive.mode == scenario::DriveMode::Demand || mp.residual_on_profile_corners;
+    // The caliper's backlash, as its end-of-line test measured it (the residual's friction model
+    // follows the spindle, not the motor).
+    const auto& backlash = scenario.corners[i].effects.backlash;
+    corner_mp.eol_backlash_rev = backlash.enabled ? backlash.width_rev : 0.0;
     supervisors_[*slot] = std::make_unique<faults::CornerSupervisor>(
         calibrator, corner_mp, static_cast<faults::Target>(*slot));
     scenario_index_[*slot] = i;

@@ -488,3 +488,50 @@ TEST(FaultMonitor, ALoadCellStepAtStandstillIsAnOffsetAtAnyForce) {
   EXPECT_TRUE(run([](int k) { return 30.0 + (k == 150 ? 1.5 : 0.0); }, false).ok(Part::LoadCell));
   EXPECT_TRUE(run([](int k) { return 30.0 + (k >= 150 ? 1.0 : 0.0); }, true).ok(Part::LoadCell));
 }
+
+// Before any fit (issue 14): once the position has swept twice the largest key-friction
+// threshold, the end-of-line friction model's state is known, its friction is subtracted and the
+// band narrows from the whole half-width to its model share; and while the actuator holds, the
+// residual keeps the level it settled at. A 0.4 kN/s load-cell drift in a held 20 kN stop (where
+// the band is 0.5 + 0.6 + 0.25 x 1.5 kN wide) is found by the hold rule within 2.5 s, the
+// healthy hold raises nothing.
+TEST(FaultMonitor, BeforeAFitTheEndOfLineFrictionModelAndTheHoldRuleFindADrift) {
+  auto run = [](double drift_kN_per_s) {
+    MonitorParams p;
+    p.eol_curve = bbw::plant::ClampCurveParams{};
+    bbw::plant::KeyFrictionParams k;
+    k.half_width_kN = 1.5;
+    p.eol_key_friction = k;
+    p.eol_friction_half_width_kN = 1.5;
+    const bbw::plant::ClampCurve eol{*p.eol_curve};
+    bbw::plant::KeyFriction keys{k};  // the caliper's own keys, from an unknown state
+    keys.reset(0.0);
+    const double T = p.eol_curve->reference_temperature_C;
+    FaultMonitor m(p, Target::FL);
+    SampleGuard g{MonitorParams{}.guard};
+    double x = 0.0, x_hold = 0.0;
+    for (int n = 1; n < 8000; ++n) {
+      const double t = 0.001 * n;
+      if (t < 1.0) x = 4.6 * t;  // apply to about 20 kN
+      if (n == 1000) x_hold = x;
+      const double speed = t < 1.0 ? 4.6 : 0.0;
+      const double drift_kN = t > 2.0 ? drift_kN_per_s * (t - 2.0) : 0.0;
+      const double lc = eol.force_kN(x, T, 0.0) + keys.step(x) + drift_kN + 0.03 * ((n % 5) - 2);
+      auto r = at(n, t, x + 2e-5 * ((n * 7) % 3), lc);
+      r.speed_rev_per_s = speed + 0.004 * ((n % 3) - 1);
+      r.temperature_C = T;
+      r.motor_current_A = lc * p.Nm_per_kN / p.torque_per_A_Nm;
+      bbw::calibration::Estimate e;
+      e.valid = true;
+      e.calibrated = false;
+      e.force_kN = lc;
+      m.update(r, g.check(r), &e, lc, t);
+    }
+    EXPECT_NEAR(x_hold, 4.6, 0.01);
+    return m.diagnosis(Part::LoadCell);
+  };
+  EXPECT_FALSE(run(0.0).present);
+  const auto d = run(0.4);
+  EXPECT_EQ(d.finding, Finding::LoadCellOffset);
+  EXPECT_LT(d.detected_s, 4.5);
+}

@@ -34,6 +34,13 @@ void MonitorParams::validate() const {
   require(std::isfinite(eol_friction_half_width_kN) && eol_friction_half_width_kN >= 0.0, "eol_friction_half_width_kN",
           eol_friction_half_width_kN, "must be >= 0");
   positive("eol_band_kN", eol_band_kN);
+  positive("hold_kN", hold_kN);
+  positive("hold_speed_rev_per_s", hold_speed_rev_per_s);
+  positive("hold_span_rev", hold_span_rev);
+  require(hold_settle_samples >= 1, "hold_settle_samples", hold_settle_samples, "must be >= 1");
+  require(std::isfinite(eol_backlash_rev) && eol_backlash_rev >= 0.0, "eol_backlash_rev", eol_backlash_rev, "must be >= 0");
+  require(std::isfinite(eol_friction_model_share) && eol_friction_model_share >= 0.0 && eol_friction_model_share <= 1.0,
+          "eol_friction_model_share", eol_friction_model_share, "must be in [0, 1]");
   require(std::isfinite(eol_friction_amplitude_factor) && eol_friction_amplitude_factor >= 1.0,
           "eol_friction_amplitude_factor", eol_friction_amplitude_factor, "must be >= 1");
   require(std::isfinite(eol_relative) && eol_relative >= 0.0, "eol_relative", eol_relative, "must be >= 0");

@@ -37,7 +37,16 @@ MonitorParams read_monitor_params(Reader& r) {
     p.eol_relative = eol.number("relative", config::Range::non_negative());
     p.eol_speed_kN_per_rev_per_s = eol.number("speed_kN_per_rev_per_s", config::Range::non_negative());
     p.eol_friction_amplitude_factor = eol.number("friction_amplitude_factor", config::Range::at_least(1.0));
+    p.eol_friction_model_share = eol.number("friction_model_share", config::Range::closed(0.0, 1.0));
     eol.finish();
+  }
+  {
+    auto h = res.map("hold");
+    p.hold_kN = h.number("kN", pos);
+    p.hold_speed_rev_per_s = h.number("speed_rev_per_s", pos);
+    p.hold_span_rev = h.number("span_rev", pos);
+    p.hold_settle_samples = static_cast<int>(h.integer("settle_samples", 1, 100000));
+    h.finish();
   }
   p.curve_min_rev = res.number("curve_min_rev");
   p.curve_max_rev = res.number("curve_max_rev");

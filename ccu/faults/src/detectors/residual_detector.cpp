@@ -4,18 +4,44 @@
 #include <cmath>
 
 #include "bbw/faults/fault_monitor.hpp"
+#include "bbw/model/play.hpp"
 
 namespace bbw::faults {
 
 ResidualDetector::ResidualDetector(const MonitorParams& p)
     : curve_min_rev_(p.curve_min_rev), curve_max_rev_(p.curve_max_rev), trusted_min_rev_(p.curve_min_rev) {
   if (p.eol_curve) eol_.emplace(*p.eol_curve);
+  if (p.eol_curve && p.eol_key_friction) {
+    plant::KeyFrictionParams k = *p.eol_key_friction;
+    k.initial_deflection = 0.0;  // the state at the start is unknown: found by sweeping
+    eol_friction_.emplace(k);
+    sweep_rev_ = 2.0 * eol_friction_->thresholds_rev().back();
+  }
 }
 
 void ResidualDetector::update(const CornerReading& r, const calibration::Estimate& e, const MonitorParams& p,
                               DiagnosisArbiter& a, NoiseDetector& noise, const StuckDetector& stuck,
                               const JumpDetector& jump) {
   const double t = r.time_s;
+  if (eol_friction_) {
+    // Every element's state is known once the position has risen (or fallen) by twice its
+    // threshold from a low (high) point: from there it slips, whatever it was before.
+    // On a caliper with backlash the keys move with the spindle, which the motor's resolver
+    // drags along within half the play (the play's state is known after the same sweep).
+    if (!have_x_) {
+      have_x_ = true;
+      spindle_rev_ = r.position_rev;
+      eol_friction_->reset(r.position_rev);
+      x_min_rev_ = x_max_rev_ = r.position_rev;
+    }
+    if (p.eol_backlash_rev > 0.0) model::play_step(spindle_rev_, r.position_rev, p.eol_backlash_rev);
+    else spindle_rev_ = r.position_rev;
+    eol_friction_kN_ = eol_friction_->step(spindle_rev_);
+    x_min_rev_ = std::min(x_min_rev_, r.position_rev);
+    x_max_rev_ = std::max(x_max_rev_, r.position_rev);
+    const double sweep_rev = sweep_rev_ + p.eol_backlash_rev;
+    if (r.position_rev - x_min_rev_ >= sweep_rev || x_max_rev_ - r.position_rev >= sweep_rev) friction_known_ = true;
+  }
   residual_kN_ = e.force_kN - e.curve_force_kN;
   // Below the trusted range (released, no clamp load) the key friction snaps back and forth with
   // small motions by up to its full width within milliseconds: that is not sensor noise.
@@ -44,9 +70,18 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   if (eol_here) {
     // The end-of-line curve at the measured temperature, with its band.
     const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
-    const double eol_kN = eol_->force_kN(r.position_rev, temperature_C, 0.0);
+    // With its friction model's state known, at the spindle's position (a caliper with backlash).
+    const double x_rev = friction_known_ ? spindle_rev_ : r.position_rev;
+    const double eol_kN = eol_->force_kN(x_rev, temperature_C, 0.0);
     residual_kN_ = r.force_kN - eol_kN;
-    thr = p.eol_friction_half_width_kN + p.eol_band_kN + p.eol_relative * std::abs(eol_kN) +
+    // The key friction: its end-of-line model once its state is known (within a share of its
+    // width: identification error, a drive's backlash), else anywhere within its width.
+    double friction_band_kN = p.eol_friction_half_width_kN;
+    if (friction_known_) {
+      residual_kN_ -= eol_friction_kN_;
+      friction_band_kN *= p.eol_friction_model_share;
+    }
+    thr = friction_band_kN + p.eol_band_kN + p.eol_relative * std::abs(eol_kN) +
           p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s);
     if (!eol_mode_) have_reference_ = false;
     eol_mode_ = true;
@@ -60,7 +95,9 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       // explains more than the end-of-line width as friction is wrong, not the load cell).
       const double hw = p.eol_friction_half_width_kN;
       const double friction_kN = std::clamp(e.friction_kN, -hw, hw);
-      residual_kN_ = e.force_kN + e.friction_kN - friction_kN - eol_->force_kN(r.position_rev, temperature_C, 0.0);
+      // At the spindle's position once the play's state is known (a caliper with backlash).
+      const double x_rev = friction_known_ ? spindle_rev_ : r.position_rev;
+      residual_kN_ = e.force_kN + e.friction_kN - friction_kN - eol_->force_kN(x_rev, temperature_C, 0.0);
     }
     if (!std::isfinite(ms_residual_kN2_)) {
       // The first fit's friction model may be poor: start from the end-of-line band (or, without
@@ -95,8 +132,43 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   change_kN_ = residual_kN_ - reference_kN_;
   const bool change_rule = !eol_here && e.calibrated;
   change_threshold_kN_ = change_rule ? change_thr : std::numeric_limits<double>::quiet_NaN();
+  // Hold rule: while the actuator holds (slow, within hold_span_rev of where the hold began),
+  // the residual keeps the level it settled at; the curve's accuracy counts only for the
+  // force the position moved through, the friction model's for its share of the width. A
+  // slow load-cell drift the force loop follows by creeping shows here, not in the level.
+  const double x_hold = eol_ && friction_known_ ? spindle_rev_ : r.position_rev;
+  double hold_curve_kN = e.curve_force_kN;
+  if (eol_) {
+    const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
+    hold_curve_kN = eol_->force_kN(x_hold, temperature_C, 0.0);
+  }
+  const bool slow = eol_here && std::abs(r.speed_rev_per_s) < p.hold_speed_rev_per_s && std::isfinite(residual_kN_);
+  if (!slow || (hold_ref_ && (std::abs(x_hold - hold_x0_rev_) > p.hold_span_rev || hold_eol_mode_ != eol_here))) {
+    hold_ref_ = false;
+    hold_slow_ = 0;
+    hold_sum_kN_ = 0.0;
+  }
+  bool hold_over = false;
+  hold_change_kN_ = std::numeric_limits<double>::quiet_NaN();
+  if (slow && !hold_ref_) {
+    ++hold_slow_;
+    hold_sum_kN_ += residual_kN_;
+    if (hold_slow_ >= p.hold_settle_samples) {
+      hold_ref_ = true;
+      hold_eol_mode_ = eol_here;
+      hold_r0_kN_ = hold_sum_kN_ / hold_slow_;
+      hold_x0_rev_ = x_hold;
+      hold_f0_kN_ = hold_curve_kN;
+    }
+  } else if (hold_ref_) {
+    hold_change_kN_ = residual_kN_ - hold_r0_kN_;
+    const double hold_thr = p.hold_kN + p.eol_relative * std::abs(hold_curve_kN - hold_f0_kN_) +
+                            p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s) +
+                            (eol_here ? (friction_known_ ? p.eol_friction_model_share : 1.0) * p.eol_friction_half_width_kN : 0.0);
+    hold_over = std::abs(hold_change_kN_) > hold_thr;
+  }
   const bool over = p.residual_findings &&
-                    (std::abs(residual_kN_) > thr || (change_rule && std::abs(change_kN_) > change_thr));
+                    (std::abs(residual_kN_) > thr || (change_rule && std::abs(change_kN_) > change_thr) || hold_over);
   if (!over && !eol_here && e.calibrated && std::isfinite(ms_residual_kN2_) && std::isfinite(change_kN_)) {
     // Healthy: the corner's own residual statistics follow (never while suspected).
     const double w = -std::expm1(-std::max(0.0, t - stats_time_s_) / p.residual_stats_s);

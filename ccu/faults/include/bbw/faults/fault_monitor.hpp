@@ -67,6 +67,23 @@ struct MonitorParams {
   // unmodelled speed effects: viscous friction, sensor delay).
   std::optional<plant::ClampCurveParams> eol_curve;
   double eol_friction_half_width_kN = 1.0;
+  // The caliper's end-of-line key-friction model (its elements, as identified on the production
+  // line; CcuCore sets the scenario's): once its state is known the end-of-line residual
+  // subtracts its friction and the band holds eol_friction_model_share x the half-width instead
+  // of the whole width.
+  std::optional<plant::KeyFrictionParams> eol_key_friction;
+  double eol_friction_model_share = 0.25;
+  // The caliper's backlash between the motor (the resolver) and the spindle (the keys, the
+  // pads), as its end-of-line test measured it (CcuCore sets the corner's; 0: none).
+  double eol_backlash_rev = 0.0;
+  // Hold rule: slower than hold_speed_rev_per_s for hold_settle_samples sets the residual's
+  // reference level (their mean); while the position stays within hold_span_rev of it, a change
+  // beyond hold_kN + eol_relative x the curve's change + the friction's uncertainty (end of line:
+  // its model share or its whole width) is a disagreement.
+  double hold_kN = 0.5;
+  double hold_speed_rev_per_s = 0.5;
+  double hold_span_rev = 0.1;
+  int hold_settle_samples = 20;
   double eol_band_kN = 0.5;
   double eol_relative = 0.03;
   double eol_speed_kN_per_rev_per_s = 0.3;

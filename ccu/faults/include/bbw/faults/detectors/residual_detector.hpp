@@ -18,6 +18,7 @@
 #include "bbw/faults/detectors/noise_detector.hpp"
 #include "bbw/faults/detectors/stuck_detector.hpp"
 #include "bbw/plant/clamp_curve.hpp"
+#include "bbw/plant/key_friction.hpp"
 
 namespace bbw::faults {
 
@@ -28,7 +29,18 @@ class ResidualDetector {
   explicit ResidualDetector(const MonitorParams& p);
   void update(const CornerReading& r, const calibration::Estimate& e, const MonitorParams& p, DiagnosisArbiter& a,
               NoiseDetector& noise, const StuckDetector& stuck, const JumpDetector& jump);
-  void on_rejoin() { suspect_ = false; }
+  void on_rejoin() {
+    suspect_ = false;
+    hold_ref_ = false;
+    hold_slow_ = 0;
+    hold_sum_kN_ = 0.0;
+    friction_known_ = false;  // the positions in the gap are unknown: so is the friction's state
+    have_x_ = false;
+  }
+  // Whether the end-of-line friction model's state is known (the position has swept twice its
+  // largest threshold since the start or the last gap), and its friction (kN).
+  bool eol_friction_known() const { return friction_known_; }
+  double eol_friction_kN() const { return eol_friction_kN_; }
   void set_curve_range(double min_rev, double max_rev) {
     curve_min_rev_ = min_rev;
     curve_max_rev_ = max_rev;
@@ -37,6 +49,9 @@ class ResidualDetector {
   // (the thresholds use these until the next fit, so a slow fault cannot widen them).
   void set_fit_rms(double fit_rms_kN) {
     fit_rms_kN_ = fit_rms_kN;
+    hold_ref_ = false;  // a new fit moves the calibrated residual by itself
+    hold_slow_ = 0;
+    hold_sum_kN_ = 0.0;
     if (std::isfinite(ms_residual_kN2_)) {
       sigma_residual_kN_ = std::sqrt(ms_residual_kN2_);
       sigma_change_kN_ = std::sqrt(ms_change_kN2_);
@@ -53,6 +68,8 @@ class ResidualDetector {
   // A disagreement is under way but not yet confirmed (persist_s).
   bool suspect() const { return suspect_; }
   double change_kN() const { return change_kN_; }
+  // The residual's change since the hold settled (NaN outside a hold).
+  double hold_change_kN() const { return hold_change_kN_; }
 
  private:
   bool suspect_ = false;
@@ -79,6 +96,24 @@ class ResidualDetector {
   double sigma_residual_kN_ = 0.0;  // snapshots at the last accepted fit
   double sigma_change_kN_ = 0.0;
   std::optional<plant::ClampCurve> eol_;
+  // The caliper's end-of-line key-friction model (Maxwell-slip elements as its production line
+  // identified them), driven by the measured position.
+  std::optional<plant::KeyFriction> eol_friction_;
+  double sweep_rev_ = 0.0;   // twice its largest threshold
+  bool friction_known_ = false;
+  bool have_x_ = false;
+  double x_min_rev_ = 0.0, x_max_rev_ = 0.0;  // since the start or the last gap
+  double eol_friction_kN_ = 0.0;
+  double spindle_rev_ = 0.0;  // the play operator's state (backlash)
+  // The hold rule's reference: the residual's level once the hold settled.
+  bool hold_ref_ = false;
+  bool hold_eol_mode_ = false;
+  int hold_slow_ = 0;
+  double hold_sum_kN_ = 0.0;
+  double hold_r0_kN_ = 0.0;
+  double hold_x0_rev_ = 0.0;
+  double hold_f0_kN_ = 0.0;
+  double hold_change_kN_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace bbw::faults
