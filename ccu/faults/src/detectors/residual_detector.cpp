@@ -45,7 +45,10 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   residual_kN_ = e.force_kN - e.curve_force_kN;
   // Below the trusted range (released, no clamp load) the key friction snaps back and forth with
   // small motions by up to its full width within milliseconds: that is not sensor noise.
-  if (r.position_rev >= trusted_min_rev_ || !eol_) noise.update(residual_kN_, t, p, a);
+  // The raw load cell against the curve at the position (the estimate is filtered: it hid noise
+  // bursts of 0.35 kN RMS in held hard stops, issue 14).
+  const double noise_kN = std::isfinite(r.force_kN) ? r.force_kN - e.curve_force_kN : residual_kN_;
+  if (r.position_rev >= trusted_min_rev_ || !eol_) noise.update(noise_kN, t, p, a);
   // With an end-of-line curve, a calibrated corner's residual is its estimate (load cell minus
   // the calibrator's friction) against that curve, everywhere above the trusted minimum: the
   // fitted cubic is an approximation fitted to wherever the cycles went, the end-of-line curve
