@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <random>
 
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/faults/corner_supervisor.hpp"
@@ -534,4 +535,21 @@ TEST(FaultMonitor, BeforeAFitTheEndOfLineFrictionModelAndTheHoldRuleFindADrift) 
   const auto d = run(0.4);
   EXPECT_EQ(d.finding, Finding::LoadCellOffset);
   EXPECT_LT(d.detected_s, 4.5);
+}
+
+// The noise rule reads the raw load cell against the curve at the position (issue 14): an
+// estimate that is filtered (as the CCU's is) does not hide a 0.35 kN RMS burst in a held stop.
+TEST(FaultMonitor, ANoiseBurstIsFoundInTheRawLoadCellNotTheFilteredEstimate) {
+  MonitorParams p;
+  SampleCheck ok;
+  FaultMonitor m(p, Target::FL);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> burst(0.0, 0.35);
+  for (int k = 1; k < 400; ++k) {
+    const double lc = 30.0 + (k > 200 ? burst(rng) : 0.0);
+    auto r = at(k, 0.001 * k, 5.8, lc);
+    const auto e = estimate(30.0, 30.0);  // filtered: the burst does not reach it
+    m.update(r, ok, &e, e.force_kN, r.time_s);
+  }
+  EXPECT_EQ(m.diagnosis(Part::LoadCell).finding, Finding::LoadCellNoisy);
 }
