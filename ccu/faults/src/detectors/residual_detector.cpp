@@ -98,9 +98,9 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       // explains more than the end-of-line width as friction is wrong, not the load cell).
       const double hw = p.eol_friction_half_width_kN;
       const double friction_kN = std::clamp(e.friction_kN, -hw, hw);
-      // At the spindle's position once the play's state is known (a caliper with backlash).
-      const double x_rev = friction_known_ ? spindle_rev_ : r.position_rev;
-      residual_kN_ = e.force_kN + e.friction_kN - friction_kN - eol_->force_kN(x_rev, temperature_C, 0.0);
+      // At the motor's position, as the calibrator fitted its friction (the spindle's, with a
+      // backlash corner's play, mixed the two and raised 6 fault-free findings on backlash corners).
+      residual_kN_ = e.force_kN + e.friction_kN - friction_kN - eol_->force_kN(r.position_rev, temperature_C, 0.0);
     }
     if (!std::isfinite(ms_residual_kN2_)) {
       // The first fit's friction model may be poor: start from the end-of-line band (or, without
@@ -139,14 +139,18 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // the residual keeps the level it settled at; the curve's accuracy counts only for the
   // force the position moved through, the friction model's for its share of the width. A
   // slow load-cell drift the force loop follows by creeping shows here, not in the level.
-  const double x_hold = eol_ && friction_known_ ? spindle_rev_ : r.position_rev;
+  const double x_hold = eol_here && friction_known_ ? spindle_rev_ : r.position_rev;
   double hold_curve_kN = e.curve_force_kN;
   if (eol_) {
     const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
     hold_curve_kN = eol_->force_kN(x_hold, temperature_C, 0.0);
   }
   const bool slow = eol_here && std::abs(r.speed_rev_per_s) < p.hold_speed_rev_per_s && std::isfinite(residual_kN_);
-  if (!slow || (hold_ref_ && (std::abs(x_hold - hold_x0_rev_) > p.hold_span_rev || hold_eol_mode_ != eol_here))) {
+  // The reference belongs to one way of computing the residual: the friction model's state
+  // becoming known moves the residual by the whole friction (a fault-free finding at 1.02 s,
+  // scoring run 1599, before this).
+  if (!slow || (hold_ref_ && (std::abs(x_hold - hold_x0_rev_) > p.hold_span_rev || hold_eol_mode_ != eol_here ||
+                              hold_known_ != friction_known_))) {
     hold_ref_ = false;
     hold_slow_ = 0;
     hold_sum_kN_ = 0.0;
@@ -159,6 +163,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     if (hold_slow_ >= p.hold_settle_samples) {
       hold_ref_ = true;
       hold_eol_mode_ = eol_here;
+      hold_known_ = friction_known_;
       hold_r0_kN_ = hold_sum_kN_ / hold_slow_;
       hold_x0_rev_ = x_hold;
       hold_f0_kN_ = hold_curve_kN;

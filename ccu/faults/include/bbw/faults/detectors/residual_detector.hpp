@@ -108,6 +108,7 @@ class ResidualDetector {
   // The hold rule's reference: the residual's level once the hold settled.
   bool hold_ref_ = false;
   bool hold_eol_mode_ = false;
+  bool hold_known_ = false;  // the friction model's state was known when the reference was set
   int hold_slow_ = 0;
   double hold_sum_kN_ = 0.0;
   double hold_r0_kN_ = 0.0;
