@@ -128,6 +128,75 @@ TEST(SlipController, AHighToLowMuJumpDropsTheIntegralToTheTyresTorqueAtOnce) {
 }
 
 namespace {
+// A wheel just under its target slip (it could take more brake) after the pads were retracted:
+// the slip controller's torque after `periods` CCU periods, its command sent back each period as
+// the BrakeController does.
+double reapply_torque(bool caliper_model, int periods, unsigned long* holds = nullptr) {
+  SlipControlParams p;
+  p.kp_Nm_per_rad_s = 0.0;  // the integral alone
+  p.caliper_model = caliper_model;
+  SlipController c(p, 0.344, 1.7, 91.2);
+  WheelInputs in;
+  in.ground_speed_m_s = 20.0;
+  in.wheel_rad_s = 0.91 * 20.0 / 0.344;  // 9 % slip: under control, 1 % short of the target
+  in.request_Nm = 2000.0;
+  in.applied_Nm = 100.0;
+  in.load_N = 3000.0;
+  for (int i = 0; i < periods; ++i) c.commanded(c.update(0.005, in).torque_Nm);
+  if (holds) *holds = c.integral_holds();
+  return c.last().torque_Nm;
+}
+}  // namespace
+
+TEST(SlipController, TheCaliperModelHoldsTheIntegralWhileThePadsCloseTheAirGap) {
+  // docs/vehicle.md: after a release the pads are back from the disc; a re-apply brakes nothing
+  // for the gap's closing time (caliper_gap_s). Integrating the wheel's error over that time only
+  // wound the command up (t_ice_80: 1.4 -> 9.5 kN before the pads touched, then a 0.5 s lock).
+  SlipControlParams p;
+  const int gap_periods = static_cast<int>(p.caliper_gap_s / 0.005) - 2;
+  unsigned long holds = 0;
+  const double with_model = reapply_torque(true, gap_periods, &holds);
+  const double without = reapply_torque(false, gap_periods);
+  EXPECT_GT(holds, 20u);
+  EXPECT_NEAR(with_model, 100.0, 3.0);        // held where it started (one period before the first command)
+  EXPECT_GT(without, with_model + 30.0);     // without the model: wound up by ki * error * time
+  // Once the model has the pads on the disc, the integral works again.
+  EXPECT_GT(reapply_torque(true, gap_periods + 60), with_model + 30.0);
+}
+
+TEST(SlipController, TheCaliperModelHoldsTheIntegralWhileAReleaseIsOnItsWay) {
+  // Under control with a high force on the disc; the wheel then slips deep: the command drops at
+  // once, but the force leaves the disc at the caliper's rate - the integral is not run down to
+  // 0 on a deceleration the command has already answered.
+  SlipControlParams p;
+  p.kp_Nm_per_rad_s = 50.0;
+  p.jump_wheel_decel_m_s2 = 1e9;  // not the mu-jump rule
+  auto run = [&](bool model) {
+    SlipControlParams q = p;
+    q.caliper_model = model;
+    SlipController c(q, 0.344, 1.7, 91.2);
+    WheelInputs in;
+    in.ground_speed_m_s = 20.0;
+    in.wheel_rad_s = 0.9 * 20.0 / 0.344;
+    in.request_Nm = 2000.0;
+    in.applied_Nm = 800.0;
+    in.load_N = 3000.0;
+    for (int i = 0; i < 100; ++i) c.commanded(c.update(0.005, in).torque_Nm);  // pads on the disc
+    in.wheel_rad_s = 0.9 * 20.0 / 0.344 + 20.0;  // well above the target: the torque is the integral
+    const double before = c.update(0.005, in).torque_Nm - q.kp_Nm_per_rad_s * 20.0;
+    c.commanded(before);
+    in.wheel_rad_s = 0.75 * 20.0 / 0.344;  // 25 % slip for 5 periods
+    for (int i = 0; i < 5; ++i) c.commanded(c.update(0.005, in).torque_Nm);
+    in.wheel_rad_s = 0.9 * 20.0 / 0.344 + 20.0;
+    const double after = c.update(0.005, in).torque_Nm - q.kp_Nm_per_rad_s * 20.0;
+    return before - after;  // how far the integral ran down
+  };
+  const double without = run(false), with_model = run(true);
+  EXPECT_GT(without, 50.0);  // about ki * 8.7 rad/s * 25 ms, less the wheel-speed filter's first period
+  EXPECT_LT(with_model, 0.2 * without) << with_model << " vs " << without;
+}
+
+namespace {
 BrakeOutput lost_corner_run(bool redistribute, std::size_t lost) {
   BrakeControlParams p;
   p.yaw.redistribute_lost_corner = redistribute;

@@ -34,6 +34,9 @@ void BrakeControlParams::validate() const {
   require(speed.up_gain_per_s > 0 && speed.down_gain_per_s >= 0 && speed.rolling_gain_per_s > 0 && speed.bias_gain_per_s >= 0 &&
               speed.bias_max_wheel_accel_m_s2 > 0,
           "speed: gains must be >= 0 (up and rolling > 0)");
+  require(slip.caliper_release_kN >= 0 && slip.caliper_gap_s > 0 && slip.caliper_retract_s > 0 && slip.caliper_rate_kN_s > 0 &&
+              slip.caliper_lag_s > 0 && slip.release_freeze_margin_Nm >= 0,
+          "slip: caliper_release_kN, release_freeze_margin_Nm >= 0; caliper_gap_s, caliper_retract_s, caliper_rate_kN_s, caliper_lag_s > 0");
 }
 
 PedalDemand pedal_demand(const PedalDemandParams& p, double travel_mm, double force_N) {
@@ -51,10 +54,10 @@ PedalDemand pedal_demand(const PedalDemandParams& p, double travel_mm, double fo
 BrakeController::BrakeController(const BrakeControlParams& p)
     : p_(p),
       speed_(p.speed, p.car.wheel_radius_m),
-      slip_{SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2),
-            SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2),
-            SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2),
-            SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2)} {
+      slip_{SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2, 2000.0 * p.car.pad_mu * p.car.front_effective_radius_m),
+            SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2, 2000.0 * p.car.pad_mu * p.car.front_effective_radius_m),
+            SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2, 2000.0 * p.car.pad_mu * p.car.rear_effective_radius_m),
+            SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2, 2000.0 * p.car.pad_mu * p.car.rear_effective_radius_m)} {
   p_.validate();
 }
 
@@ -242,6 +245,7 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
     // closing time (about 45 ms) on every re-apply.
     if (m.available[w] && out_.wheels[w].active && z_request > 0.0)
       out_.clamp_force_kN[w] = std::max(out_.clamp_force_kN[w], p_.slip.active_min_clamp_kN);
+    slip_[w].commanded(torque_Nm(w, out_.clamp_force_kN[w]));  // the caliper model's input
   }
   return out_;
 }

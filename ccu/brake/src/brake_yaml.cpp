@@ -69,6 +69,13 @@ BrakeControlParams read_brake_control(Reader& r) {
     p.slip.jump_slip_margin = c.number("jump_slip_margin", Range::closed(0, 0.5));
     p.slip.jump_release_factor = c.number("jump_release_factor", Range::closed(0, 1));
     p.slip.active_min_clamp_kN = c.number("active_min_clamp_kN", Range::closed(0, 5));
+    p.slip.caliper_model = c.boolean("caliper_model");
+    p.slip.caliper_release_kN = c.number("caliper_release_kN", Range::closed(0, 5));
+    p.slip.caliper_gap_s = c.number("caliper_gap_s", Range::closed(0.001, 1));
+    p.slip.caliper_retract_s = c.number("caliper_retract_s", Range::closed(0.001, 1));
+    p.slip.caliper_rate_kN_s = c.number("caliper_rate_kN_s", Range::positive());
+    p.slip.caliper_lag_s = c.number("caliper_lag_s", Range::closed(0.001, 1));
+    p.slip.release_freeze_margin_Nm = c.number("release_freeze_margin_Nm", Range::closed(0, 1000));
     c.finish();
   }
   {

@@ -6,9 +6,27 @@
 
 namespace bbw::brake {
 
-SlipController::SlipController(const SlipControlParams& p, double wheel_radius_m, double wheel_inertia_kg_m2)
-    : p_(p), radius_m_(wheel_radius_m), inertia_kg_m2_(wheel_inertia_kg_m2), target_(p.target_slip) {
-  if (!(wheel_radius_m > 0.0) || !(wheel_inertia_kg_m2 > 0.0)) throw std::invalid_argument("SlipController: radius and inertia must be > 0");
+SlipController::SlipController(const SlipControlParams& p, double wheel_radius_m, double wheel_inertia_kg_m2, double Nm_per_kN)
+    : p_(p), radius_m_(wheel_radius_m), inertia_kg_m2_(wheel_inertia_kg_m2), Nm_per_kN_(Nm_per_kN), target_(p.target_slip) {
+  if (!(wheel_radius_m > 0.0) || !(wheel_inertia_kg_m2 > 0.0) || !(Nm_per_kN > 0.0))
+    throw std::invalid_argument("SlipController: radius, inertia and Nm_per_kN must be > 0");
+}
+
+void SlipController::caliper_step(double dt_s) {
+  const double cmd_kN = std::max(0.0, sent_Nm_) / Nm_per_kN_;
+  const bool apply = cmd_kN > p_.caliper_release_kN;
+  if (apply && gap_ > 0.0) {
+    gap_ = std::max(0.0, gap_ - dt_s / p_.caliper_gap_s);  // closing the air gap: nothing brakes yet
+  } else {
+    const double target = apply ? cmd_kN : 0.0;
+    // The force loop's lag, at most the motor's rate.
+    model_kN_ += std::clamp((target - model_kN_) * std::min(1.0, dt_s / p_.caliper_lag_s), -p_.caliper_rate_kN_s * dt_s,
+                            p_.caliper_rate_kN_s * dt_s);
+    if (!apply && model_kN_ <= p_.caliper_release_kN) {
+      model_kN_ = 0.0;  // the pads leave the disc and the air gap opens
+      gap_ = std::min(1.0, gap_ + dt_s / p_.caliper_retract_s);
+    }
+  }
 }
 
 void SlipController::search(double dt_s, double slip) {
@@ -42,6 +60,7 @@ const WheelDecision& SlipController::update(double dt_s, const WheelInputs& in) 
     started_ = true;
   }
   w_filt_ += a * (in.wheel_rad_s - w_filt_);
+  if (p_.caliper_model) caliper_step(dt_s);
   const double w_dot_raw = (w_filt_ - w_prev_) / dt_s;
   w_prev_ = w_filt_;
   const double b = std::min(1.0, dt_s / p_.mu_filter_s);
@@ -87,7 +106,16 @@ const WheelDecision& SlipController::update(double dt_s, const WheelInputs& in) 
     integral_Nm_ = std::min(integral_Nm_, p_.jump_release_factor * tyre_Nm);
     ++jumps_;
   }
-  integral_Nm_ = std::clamp(integral_Nm_ + p_.ki_Nm_per_rad * err * dt_s, 0.0, request);
+  // The caliper model says the command has not reached the disc yet: while the pads close the
+  // air gap nothing brakes, so a wheel spinning up is no reason to integrate the command up
+  // (that wound it up to several times what an ice tyre carries before the pads touched); while
+  // the force on the disc is still above the command the release is on its way, so a wheel
+  // still slowing is no reason to integrate it down. The proportional part acts throughout.
+  const bool closing = p_.caliper_model && gap_ > 0.0 && sent_Nm_ / Nm_per_kN_ > p_.caliper_release_kN;
+  const bool releasing = p_.caliper_model && model_kN_ * Nm_per_kN_ > std::max(0.0, sent_Nm_) + p_.release_freeze_margin_Nm;
+  if (closing && err > 0.0) ++held_;
+  else if (releasing && err < 0.0) ++held_;
+  else integral_Nm_ = std::clamp(integral_Nm_ + p_.ki_Nm_per_rad * err * dt_s, 0.0, request);
   const double torque = std::clamp(integral_Nm_ + p_.kp_Nm_per_rad_s * err, 0.0, request);
   d_.torque_Nm = torque;
   // The driver asks for less than the wheel can carry: hand back.

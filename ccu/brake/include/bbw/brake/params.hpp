@@ -74,6 +74,20 @@ struct SlipControlParams {
   double jump_release_factor = 0.8;
   // Clamp force kept while the slip controller acts (the pads stay on the disc).
   double active_min_clamp_kN = 0.3;
+  // The CCU's model of the e-caliper's answer to its own command (docs/vehicle.md, "The CCU's
+  // brake functions"): at or below caliper_release_kN the corner retracts the pads - the force
+  // falls (lag caliper_lag_s, at most caliper_rate_kN_s), then the air gap opens over
+  // caliper_retract_s; an apply first closes the gap (caliper_gap_s from fully open: nothing
+  // brakes), then the force follows the command (the same lag and rate). With the model the PI
+  // integral is held while the command is on its way: not up while the gap closes, not down while
+  // the model's force is more than release_freeze_margin_Nm above the command.
+  bool caliper_model = false;
+  double caliper_release_kN = 0.1;
+  double caliper_gap_s = 0.14;
+  double caliper_retract_s = 0.025;
+  double caliper_rate_kN_s = 90.0;
+  double caliper_lag_s = 0.02;
+  double release_freeze_margin_Nm = 20.0;
 };
 
 struct YawLimitParams {

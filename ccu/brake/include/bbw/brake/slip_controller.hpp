@@ -28,16 +28,27 @@ struct WheelDecision {
 
 class SlipController {
  public:
-  SlipController(const SlipControlParams& p, double wheel_radius_m, double wheel_inertia_kg_m2);
+  // Nm_per_kN: the CCU's brake model (torque per kN of clamp force) for the caliper model.
+  SlipController(const SlipControlParams& p, double wheel_radius_m, double wheel_inertia_kg_m2, double Nm_per_kN = 91.2);
   const WheelDecision& update(double dt_s, const WheelInputs& in);
+  // The torque actually sent to the corner this period (after the yaw-moment limitation and the
+  // clamp-force limits): the caliper model's input for the next period.
+  void commanded(double torque_Nm) { sent_Nm_ = torque_Nm; }
+  double model_torque_Nm() const { return model_kN_ * Nm_per_kN_; }  // the caliper model's force at the disc, as torque
+  double model_gap() const { return gap_; }                         // 0: pads on the disc, 1: fully retracted
+  unsigned long integral_holds() const { return held_; }          // periods the integral was held (caliper model)
   const WheelDecision& last() const { return d_; }
   double target_slip() const { return target_; }
   unsigned long jump_releases() const { return jumps_; }  // high-to-low mu jumps released
 
  private:
   void search(double dt_s, double slip);
+  void caliper_step(double dt_s);
   SlipControlParams p_;
-  double radius_m_, inertia_kg_m2_;
+  double radius_m_, inertia_kg_m2_, Nm_per_kN_;
+  // The caliper model: the torque sent last period, the force at the disc, the air gap (0 closed, 1 open).
+  double sent_Nm_ = 0.0, model_kN_ = 0.0, gap_ = 1.0;
+  unsigned long held_ = 0;
   double w_filt_ = 0.0, w_prev_ = 0.0, w_dot_ = 0.0;
   bool started_ = false;
   double integral_Nm_ = 0.0;
