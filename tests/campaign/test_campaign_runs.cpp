@@ -47,15 +47,16 @@ std::string small_spec(const std::string& dir, int runs) {
 // The CI subset (config/campaigns/ci.yaml, 36 runs, every kind, onset and profile): every fault
 // above its limit detected rightly within its window, and nothing else raised.
 // The goal for this subset is every fault detected and no false alarm; the diagnosis does
-// not reach it yet (docs/faults.md, "Diagnosis across calipers and driving": 25 of 39 detected,
-// 1 + 2 false alarms with only credible fits judged, 2 + 8 before, 3 + 9 after the local loop's
+// not reach it yet (docs/faults.md, "Diagnosis across calipers and driving": 32 of 39 detected,
+// 1 + 1 false alarms with the fourth session's rules (2026-11-26); 25 of 39, 1 + 2 with only
+// credible fits judged, 2 + 8 before, 3 + 9 after the local loop's
 // fix, 5 + 13 before it, measured 2026-11-23). Lockstep runs are deterministic, so the subset is a
 // ratchet: it fails when the diagnosis gets worse than measured, and its bounds move to the goal
 // as the diagnosis improves (kMinDetected up to n, the false-alarm bounds down to 0).
 TEST(CampaignSystem, CiSubsetOverDdsIsNoWorseThanMeasured) {
-  constexpr int kMinDetected = 25;             // goal: every fault
+  constexpr int kMinDetected = 32;             // goal: every fault (25 before the fourth session's rules)
   constexpr int kMaxFalseAlarmsFaultFree = 1;  // goal: 0 (2 before credible fits, 3 before the friction memory, 5 before the local loop's fix)
-  constexpr int kMaxFalseAlarmsFaulty = 2;     // goal: 0 (8 before credible fits, 9 before the friction memory, 13 before the local loop's fix)
+  constexpr int kMaxFalseAlarmsFaulty = 1;     // goal: 0 (2 before the fourth session's rules, 8 before credible fits, 9 before the friction memory, 13 before the local loop's fix)
   const std::string dir = bbw::system_test::scratch("campaign", "ci");
   const auto t0 = std::chrono::steady_clock::now();
   const auto r = campaign(dir, "ci", {src("config/campaigns/ci.yaml"), "--out", dir + "/c", "--jobs", "2"}, 300s);
