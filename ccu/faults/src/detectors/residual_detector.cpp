@@ -46,8 +46,17 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // Below the trusted range (released, no clamp load) the key friction snaps back and forth with
   // small motions by up to its full width within milliseconds: that is not sensor noise.
   // The raw load cell against the curve at the position (the estimate is filtered: it hid noise
-  // bursts of 0.35 kN RMS in held hard stops, issue 14).
-  const double noise_kN = std::isfinite(r.force_kN) ? r.force_kN - e.curve_force_kN : residual_kN_;
+  // bursts of 0.35 kN RMS in held hard stops, issue 14); with an end-of-line curve, against it
+  // and the end-of-line friction model once its state is known (beyond the fitted range the
+  // calibrator's curve has the wrong slope: a 15 rev/s release from 36 kN moved the difference
+  // by 0.1-0.3 kN per sample and raised load_cell_noisy on two healthy corners, tuning run 367).
+  double curve_kN = e.curve_force_kN;
+  if (eol_) {
+    const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
+    curve_kN = eol_->force_kN(friction_known_ ? spindle_rev_ : r.position_rev, temperature_C, 0.0) +
+               (friction_known_ ? eol_friction_kN_ : 0.0);
+  }
+  const double noise_kN = std::isfinite(r.force_kN) ? r.force_kN - curve_kN : residual_kN_;
   if (r.position_rev >= trusted_min_rev_ || !eol_) noise.update(noise_kN, t, p, a);
   // With an end-of-line curve, a calibrated corner's residual is its estimate (load cell minus
   // the calibrator's friction) against that curve, everywhere above the trusted minimum: the
