@@ -553,3 +553,27 @@ TEST(FaultMonitor, ANoiseBurstIsFoundInTheRawLoadCellNotTheFilteredEstimate) {
   }
   EXPECT_EQ(m.diagnosis(Part::LoadCell).finding, Finding::LoadCellNoisy);
 }
+
+// With an end-of-line curve the noise rule reads the load cell against it (issue 14): a fast
+// release beyond the fitted range, where the calibrator's curve has the wrong slope, is not noise
+// (tuning run 367: load_cell_noisy on two healthy corners in a 15 rev/s release from 36 kN).
+TEST(FaultMonitor, AFastReleaseWhereTheFittedCurveHasTheWrongSlopeIsNotNoise) {
+  MonitorParams p;
+  p.eol_curve = bbw::plant::ClampCurveParams{};
+  const bbw::plant::ClampCurve eol{*p.eol_curve};
+  const double T = p.eol_curve->reference_temperature_C;
+  SampleCheck ok;
+  FaultMonitor m(p, Target::FR);
+  for (int k = 1; k < 150; ++k) {
+    const double x = 7.2 - 0.016 * k;  // 16 rev/s down from 7.2 rev
+    const double lc = eol.force_kN(x, T, 0.0) + 0.03 * ((k % 5) - 2);
+    auto r = at(k, 0.001 * k, x, lc);
+    r.speed_rev_per_s = -16.0;
+    r.temperature_C = T;
+    r.motor_current_A = -5.0;
+    auto e = estimate(lc, 0.0);  // a fitted curve far off its range (none at all here)
+    e.calibrated = false;
+    m.update(r, ok, &e, lc, r.time_s);
+  }
+  EXPECT_TRUE(m.ok(Part::LoadCell)) << to_string(m.diagnosis(Part::LoadCell).finding);
+}
