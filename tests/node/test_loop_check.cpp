@@ -42,7 +42,16 @@ TEST(LoopCheck, TuningMember13RaisesNothingFaultFree) {
     EXPECT_LT(c.current_hp_rms_A, 3.0) << c.corner;    // no current limit cycle
     EXPECT_LT(c.load_cell_step_kN, 0.3) << c.corner;   // no kN steps of the load cell
   }
-  // Without it, the same run raised load_cell_noisy on every corner (what the fix is for).
+  // Without it the loop limit-cycles on every corner (what the fix is for). Until issue 14's
+  // fourth session the monitor named that load_cell_noisy on every corner; since the noise rule
+  // reads the load cell against the end-of-line curve and friction model, a force that follows
+  // the hunting position is no longer taken for sensor noise, so the limit cycle is asserted on
+  // the loop's own figures.
   const auto without = measure_member(13, false);
-  EXPECT_GE(without.findings(), 4u) << findings(without);
+  // Measured 2026-11-26: current 22.9-27.1 A high-passed RMS, load-cell steps 0.64-0.73 kN.
+  ASSERT_EQ(without.corners.size(), 4u);
+  for (const auto& c : without.corners) {
+    EXPECT_GT(c.current_hp_rms_A, 10.0) << c.corner;   // the current limit cycle
+    EXPECT_GT(c.load_cell_step_kN, 0.5) << c.corner;   // kN steps of the load cell
+  }
 }
