@@ -43,19 +43,21 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     if (r.position_rev - x_min_rev_ >= sweep_rev || x_max_rev_ - r.position_rev >= sweep_rev) friction_known_ = true;
   }
   residual_kN_ = e.force_kN - e.curve_force_kN;
-  // Below the trusted range (released, no clamp load) the key friction snaps back and forth with
-  // small motions by up to its full width within milliseconds: that is not sensor noise.
+  // The end-of-line curve where the keys and pads are (the spindle, once the friction model's
+  // state is known; else the motor) at the measured temperature: evaluated once per sample for
+  // the noise input, the end-of-line residual and the hold rule.
+  const double temperature_C =
+      eol_ && std::isfinite(r.temperature_C) ? r.temperature_C : eol_ ? eol_->params().reference_temperature_C : 0.0;
+  const double x_keys_rev = friction_known_ ? spindle_rev_ : r.position_rev;
+  const double eol_keys_kN = eol_ ? eol_->force_kN(x_keys_rev, temperature_C, 0.0) : e.curve_force_kN;
   // The raw load cell against the curve at the position (the estimate is filtered: it hid noise
   // bursts of 0.35 kN RMS in held hard stops, issue 14); with an end-of-line curve, against it
   // and the end-of-line friction model once its state is known (beyond the fitted range the
   // calibrator's curve has the wrong slope: a 15 rev/s release from 36 kN moved the difference
   // by 0.1-0.3 kN per sample and raised load_cell_noisy on two healthy corners, tuning run 367).
-  double curve_kN = e.curve_force_kN;
-  if (eol_) {
-    const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
-    curve_kN = eol_->force_kN(friction_known_ ? spindle_rev_ : r.position_rev, temperature_C, 0.0) +
-               (friction_known_ ? eol_friction_kN_ : 0.0);
-  }
+  // Below the trusted range (released, no clamp load) the key friction snaps back and forth with
+  // small motions by up to its full width within milliseconds: that is not sensor noise.
+  const double curve_kN = eol_keys_kN + (eol_ && friction_known_ ? eol_friction_kN_ : 0.0);
   const double noise_kN = std::isfinite(r.force_kN) ? r.force_kN - curve_kN : residual_kN_;
   if (r.position_rev >= trusted_min_rev_ || !eol_) noise.update(noise_kN, t, p, a);
   // With an end-of-line curve, a calibrated corner's residual is its estimate (load cell minus
@@ -80,11 +82,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   }
   double thr = 0.0, change_thr = 0.0;
   if (eol_here) {
-    // The end-of-line curve at the measured temperature, with its band.
-    const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
-    // With its friction model's state known, at the spindle's position (a caliper with backlash).
-    const double x_rev = friction_known_ ? spindle_rev_ : r.position_rev;
-    const double eol_kN = eol_->force_kN(x_rev, temperature_C, 0.0);
+    // The end-of-line curve where the keys are, with its band.
+    const double eol_kN = eol_keys_kN;
     residual_kN_ = r.force_kN - eol_kN;
     // The key friction: its end-of-line model once its state is known (within a share of its
     // width: identification error, a drive's backlash), else anywhere within its width.
@@ -102,14 +101,14 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     eol_mode_ = false;
   } else {
     if (eol_) {
-      const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
       // The calibrator's friction, within what the caliper's key friction can hold (a fit that
       // explains more than the end-of-line width as friction is wrong, not the load cell).
       const double hw = p.eol_friction_half_width_kN;
       const double friction_kN = std::clamp(e.friction_kN, -hw, hw);
       // At the motor's position, as the calibrator fitted its friction (the spindle's, with a
       // backlash corner's play, mixed the two and raised 6 fault-free findings on backlash corners).
-      residual_kN_ = e.force_kN + e.friction_kN - friction_kN - eol_->force_kN(r.position_rev, temperature_C, 0.0);
+      const double eol_motor_kN = x_keys_rev == r.position_rev ? eol_keys_kN : eol_->force_kN(r.position_rev, temperature_C, 0.0);
+      residual_kN_ = e.force_kN + e.friction_kN - friction_kN - eol_motor_kN;
     }
     if (!std::isfinite(ms_residual_kN2_)) {
       // The first fit's friction model may be poor: start from the end-of-line band (or, without
@@ -148,12 +147,9 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // the residual keeps the level it settled at; the curve's accuracy counts only for the
   // force the position moved through, the friction model's for its share of the width. A
   // slow load-cell drift the force loop follows by creeping shows here, not in the level.
-  const double x_hold = eol_here && friction_known_ ? spindle_rev_ : r.position_rev;
-  double hold_curve_kN = e.curve_force_kN;
-  if (eol_) {
-    const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
-    hold_curve_kN = eol_->force_kN(x_hold, temperature_C, 0.0);
-  }
+  // (Only where the end-of-line residual is used: there its position and curve are the keys'.)
+  const double x_hold = x_keys_rev;
+  const double hold_curve_kN = eol_keys_kN;
   const bool slow = eol_here && std::abs(r.speed_rev_per_s) < p.hold_speed_rev_per_s && std::isfinite(residual_kN_);
   // The reference belongs to one way of computing the residual: the friction model's state
   // becoming known moves the residual by the whole friction (a fault-free finding at 1.02 s,
