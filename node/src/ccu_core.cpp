@@ -33,6 +33,25 @@ faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, fau
   return base;
 }
 
+faults::MonitorParams corner_monitor_params(const scenario::Scenario& scenario, std::size_t corner_index,
+                                            const faults::MonitorParams& scenario_params) {
+  const auto& corner = scenario.corners.at(corner_index);
+  // The residual rules' thresholds were set on the vehicle campaigns (demand-driven corners
+  // near 35 C). On the paper's rig (corners follow their own position profile at 30-60 C and
+  // up to 12 rev/s) they raise false load-cell findings (3 of 4 corners in
+  // tests/system/data/short_rig.yaml), and the CCU has no command there to react with: rig
+  // corners keep the guard and the link, stuck, noise, dropout and actuator rules only, unless
+  // config/faults/monitor.yaml says residual.on_profile_corners: true.
+  faults::MonitorParams corner_mp = scenario_params;
+  corner_mp.residual_findings =
+      corner.drive.mode == scenario::DriveMode::Demand || scenario_params.residual_on_profile_corners;
+  // The caliper's backlash, as its end-of-line test measured it (the residual's friction model
+  // follows the spindle, not the motor).
+  const auto& backlash = corner.effects.backlash;
+  corner_mp.eol_backlash_rev = backlash.enabled ? backlash.width_rev : 0.0;
+  return corner_mp;
+}
+
 CcuCore::CcuCore(const scenario::Scenario& scenario, const calibration::CalibratorConfig& calibrator,
                  const faults::MonitorParams& monitor, ReactionPolicy policy)
     : scenario_(scenario), policy_(policy), planner_(scenario) {
@@ -46,19 +65,7 @@ CcuCore::CcuCore(const scenario::Scenario& scenario, const calibration::Calibrat
     if (supervisors_[*slot]) {
       throw std::invalid_argument(scenario.file + ": corner " + scenario.corners[i].name + " appears twice");
     }
-    // The residual rules' thresholds were set on the vehicle campaigns (demand-driven corners
-    // near 35 C). On the paper's rig (corners follow their own position profile at 30-60 C and
-    // up to 12 rev/s) they raise false load-cell findings (3 of 4 corners in
-    // tests/system/data/short_rig.yaml), and the CCU has no command there to react with: rig
-    // corners keep the guard and the link, stuck, noise, dropout and actuator rules only, unless
-    // config/faults/monitor.yaml says residual.on_profile_corners: true.
-    faults::MonitorParams corner_mp = mp;
-    corner_mp.residual_findings =
-        scenario.corners[i].drive.mode == scenario::DriveMode::Demand || mp.residual_on_profile_corners;
-    // The caliper's backlash, as its end-of-line test measured it (the residual's friction model
-    // follows the spindle, not the motor).
-    const auto& backlash = scenario.corners[i].effects.backlash;
-    corner_mp.eol_backlash_rev = backlash.enabled ? backlash.width_rev : 0.0;
+    const faults::MonitorParams corner_mp = corner_monitor_params(scenario, i, mp);
     supervisors_[*slot] = std::make_unique<faults::CornerSupervisor>(
         calibrator, corner_mp, static_cast<faults::Target>(*slot));
     scenario_index_[*slot] = i;

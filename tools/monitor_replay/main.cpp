@@ -55,9 +55,19 @@ int run(int argc, char** argv) {
   const std::string log_file = argv[2];
   auto fs = bbw::faults::load_fault_scenario(argv[1]);
   auto cal = bbw::calibration::load_config(bbw::data::path("config/calibrator/robust.yaml"));
-  auto mp = bbw::ccu::monitor_params_for(fs.scenario, bbw::faults::load_monitor_params(bbw::data::path("config/faults/monitor.yaml")));
+  const auto scenario_mp =
+      bbw::ccu::monitor_params_for(fs.scenario, bbw::faults::load_monitor_params(bbw::data::path("config/faults/monitor.yaml")));
   const auto target = bbw::faults::target_from_name(argv[3]);
   if (!target) return usage(std::string("CORNER must be FL, FR, RL or RR, got '") + argv[3] + "'");
+  // The corner's own parameters, as the CCU builds them (its backlash, residual findings on or off).
+  std::size_t corner_index = fs.scenario.corners.size();
+  for (std::size_t i = 0; i < fs.scenario.corners.size(); ++i) {
+    if (fs.scenario.corners[i].name == argv[3]) corner_index = i;
+  }
+  if (corner_index == fs.scenario.corners.size()) {
+    return usage(std::string(argv[1]) + " has no corner '" + argv[3] + "'");
+  }
+  const auto mp = bbw::ccu::corner_monitor_params(fs.scenario, corner_index, scenario_mp);
   bbw::faults::CornerSupervisor sup(cal, mp, *target);
   std::ifstream in(log_file);
   if (!in) throw std::runtime_error(log_file + ": cannot read");

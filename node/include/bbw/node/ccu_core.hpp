@@ -97,4 +97,10 @@ class CcuCore {
 // kN, inertia); everything else from `base`.
 faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, faults::MonitorParams base = {});
 
+// One corner's monitor parameters: `monitor_params_for`'s, with what belongs to that corner
+// (residual findings on demand-driven corners, its backlash as its end-of-line test measured it).
+// The CCU and bbw_monitor_replay both build a corner's monitor from this.
+faults::MonitorParams corner_monitor_params(const scenario::Scenario& scenario, std::size_t corner_index,
+                                            const faults::MonitorParams& scenario_params);
+
 }  // namespace bbw::ccu
