@@ -38,6 +38,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.eol_speed_kN_per_rev_per_s = eol.number("speed_kN_per_rev_per_s", config::Range::non_negative());
     p.eol_friction_amplitude_factor = eol.number("friction_amplitude_factor", config::Range::at_least(1.0));
     p.eol_friction_model_share = eol.number("friction_model_share", config::Range::closed(0.0, 1.0));
+    p.calibrated_two_friction_models = eol.boolean("calibrated_two_friction_models");
     eol.finish();
   }
   {

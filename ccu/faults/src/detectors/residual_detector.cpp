@@ -109,6 +109,18 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       // backlash corner's play, mixed the two and raised 6 fault-free findings on backlash corners).
       const double eol_motor_kN = x_keys_rev == r.position_rev ? eol_keys_kN : eol_->force_kN(r.position_rev, temperature_C, 0.0);
       residual_kN_ = e.force_kN + e.friction_kN - friction_kN - eol_motor_kN;
+      if (friction_known_ && p.calibrated_two_friction_models) {
+        // Two models of the key friction: the calibrator's (fitted to the cycles, on the
+        // motor's position) and the end-of-line one (identified on the production line, on the
+        // spindle). A load-cell fault moves the load cell against both; where they disagree the
+        // friction lies somewhere between them. The residual is the one nearest zero, 0 when
+        // they bracket it: at a reversal the calibrator's elements, fitted on their own
+        // thresholds, lag a friction that flips within 0.02 rev (fault-free findings on a
+        // backlash corner of a non-ideal caliper, tuning seed 1403 run 601).
+        const double eol_model_kN = e.force_kN + e.friction_kN - eol_keys_kN - eol_friction_kN_;
+        const double lo = std::min(residual_kN_, eol_model_kN), hi = std::max(residual_kN_, eol_model_kN);
+        residual_kN_ = std::clamp(0.0, lo, hi);
+      }
     }
     if (!std::isfinite(ms_residual_kN2_)) {
       // The first fit's friction model may be poor: start from the end-of-line band (or, without

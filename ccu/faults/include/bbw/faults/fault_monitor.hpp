@@ -73,6 +73,10 @@ struct MonitorParams {
   // of the whole width.
   std::optional<plant::KeyFrictionParams> eol_key_friction;
   double eol_friction_model_share = 0.25;
+  // Calibrated, once the end-of-line friction model's state is known: the residual is the one of
+  // the two friction models' (the calibrator's, the end-of-line one) nearest zero, 0 when they
+  // bracket it (a load-cell fault moves the load cell against both).
+  bool calibrated_two_friction_models = true;
   // The caliper's backlash between the motor (the resolver) and the spindle (the keys, the
   // pads), as its end-of-line test measured it (CcuCore sets the corner's; 0: none).
   double eol_backlash_rev = 0.0;
