@@ -80,6 +80,7 @@ class ResidualDetector {
   bool have_reference_ = false;
   bool reference_calibrated_ = false;  // the calibrator's state when the reference was set
   double reference_kN_ = 0.0;
+  double reference_speed_rev_per_s_ = 0.0;  // the speed low-passed and frozen as reference_kN_
   double reference_time_s_ = 0.0;
   double curve_min_rev_;
   double curve_max_rev_;
