@@ -6,18 +6,21 @@
 
 namespace bbw::faults {
 
-void NoiseDetector::update(double residual_kN, double t, const MonitorParams& p, DiagnosisArbiter& a) {
+void NoiseDetector::update(double residual_kN, double model_kN, double t, const MonitorParams& p, DiagnosisArbiter& a) {
   if (!have_prev_residual_) {
     have_prev_residual_ = true;
     prev_residual_kN_ = residual_kN;
+    prev_model_kN_ = model_kN;
     return;
   }
   const double d = residual_kN - prev_residual_kN_;
+  const double model_step_kN = std::isfinite(model_kN - prev_model_kN_) ? std::abs(model_kN - prev_model_kN_) : 0.0;
   prev_residual_kN_ = residual_kN;
+  prev_model_kN_ = model_kN;
   const int w = p.noise_window_samples;
   const auto h = static_cast<std::size_t>(head_);
   if (count_ == w) big_count_ -= big_[h];
-  big_[h] = std::abs(d) > p.noise_step_kN ? 1 : 0;
+  big_[h] = std::abs(d) > p.noise_step_kN + model_step_kN ? 1 : 0;
   big_count_ += big_[h];
   head_ = (head_ + 1) % w;
   if (count_ < w) ++count_;

@@ -1,6 +1,10 @@
 // A noisy load cell: in a window of the residual's sample-to-sample changes, the share larger
 // than noise_step_kN (a single step, e.g. a bias or a resolver jump, is one sample, not noise)
-// reaching noise_min_fraction (LoadCellNoisy). Memory sized at compile time (kMaxNoiseWindow).
+// reaching noise_min_fraction (LoadCellNoisy). A change the model itself made in that sample
+// (model_kN, what the residual is taken against) is allowed on top: where the load cell follows
+// the model late (a 5 ms sensor delay at an ABS reversal, the key friction flipping by 2 kN
+// within 5 ms) the residual steps twice, once with the model and once with the load cell.
+// Memory sized at compile time (kMaxNoiseWindow).
 #pragma once
 
 #include <array>
@@ -14,13 +18,14 @@ inline constexpr int kMaxNoiseWindow = 256;
 
 class NoiseDetector {
  public:
-  void update(double residual_kN, double t, const MonitorParams& p, DiagnosisArbiter& a);
+  void update(double residual_kN, double model_kN, double t, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() { have_prev_residual_ = false; }
   double fraction() const { return fraction_; }
 
  private:
   bool have_prev_residual_ = false;
   double prev_residual_kN_ = 0.0;
+  double prev_model_kN_ = 0.0;
   std::array<std::uint8_t, kMaxNoiseWindow> big_{};
   int count_ = 0;
   int head_ = 0;
