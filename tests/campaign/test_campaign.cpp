@@ -131,6 +131,20 @@ TEST(CampaignDraw, EveryDrawLoadsAsAFaultScenarioWithinTheSpec) {
   EXPECT_GT(intermittent, 10);
 }
 
+// Above the detectability limit: by magnitude; a drift also by the offset it reaches (a bias's
+// limit, 1 kN), so an intermittent drift that ends first is below it, whatever its rate.
+TEST(CampaignDraw, ADriftIsAboveItsLimitOnlyOnceItsOffsetReachesTheBiasLimit) {
+  EXPECT_TRUE(above_limit("bias", 1.0, 2.0, 2.1));
+  EXPECT_FALSE(above_limit("bias", -0.9, 2.0, 20.0));
+  EXPECT_FALSE(above_limit("drift", 0.1, 2.0, 20.0));           // slower than the slowest rate promised
+  EXPECT_TRUE(above_limit("drift", -0.2, 2.0, 7.0));            // reaches 1 kN at 7 s
+  EXPECT_FALSE(above_limit("drift", 0.2, 2.0, 6.9));            // ends at 0.98 kN
+  EXPECT_FALSE(above_limit("drift", 1.5, 0.466, 0.967));        // intermittent: 0.75 kN (tune_b run 66)
+  EXPECT_TRUE(above_limit("drift", 1.5, 0.466, 1.2));
+  EXPECT_TRUE(above_limit("load_cell_stuck", 0.0, 2.0, 2.01));  // no magnitude
+  EXPECT_FALSE(above_limit("torque_loss", 40.0, 2.0, 20.0));
+}
+
 TEST(CampaignStats, IntervalsAndBoundsMatchTheTextbook) {
   // Clopper-Pearson for 0/10: [0, 0.3085]; 10/10: [0.6915, 1]; 5/10: [0.1871, 0.8129].
   EXPECT_NEAR(clopper_pearson95(0, 10).hi, 0.30850, 1e-4);

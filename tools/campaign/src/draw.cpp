@@ -231,6 +231,17 @@ double detectability_limit(FaultKind kind) {
   }
 }
 
+bool above_limit(const std::string& kind, double magnitude, double at_s, double end_s) {
+  for (FaultKind k : {FaultKind::Bias, FaultKind::Drift, FaultKind::NoiseBurst, FaultKind::ResolverOffset,
+                      FaultKind::TorqueLoss, FaultKind::Delay}) {
+    if (kind != to_string(k)) continue;
+    if (std::abs(magnitude) < detectability_limit(k) - 1e-9) return false;
+    if (k == FaultKind::Drift) return std::abs(magnitude) * (end_s - at_s) >= detectability_limit(FaultKind::Bias) - 1e-9;
+    return true;
+  }
+  return true;
+}
+
 double kind_max_magnitude(FaultKind kind) {
   switch (kind) {
     case FaultKind::Bias: return 3.0;

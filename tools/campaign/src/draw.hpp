@@ -37,6 +37,12 @@ struct RunPlan {
 // draws magnitudes from it up to kind_max_magnitude. Unit: kN (bias), kN/s (drift), kN RMS
 // (noise), rev (resolver offset), % (torque loss), ms (delay); 0 for kinds without a magnitude.
 double detectability_limit(FaultKind kind);
+// Whether an injected fault (its kind's name, magnitude, start and end) is above its kind's
+// detectability limit. A drift's limit is a bias's, reached after limit / rate
+// (docs/faults.md, "Detectability limits"): one that ends (intermittent, or with the run) before
+// its offset reaches the bias limit is not above it, whatever its rate. Kinds without a magnitude
+// (stuck, loss, dropout, silence, seized) always are.
+bool above_limit(const std::string& kind, double magnitude, double at_s, double end_s);
 double kind_max_magnitude(FaultKind kind);
 
 RunPlan draw_run(const CampaignSpec& spec, int index);

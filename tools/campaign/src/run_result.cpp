@@ -51,10 +51,7 @@ void score_into(RunResult& r, const std::vector<faults::FaultSpec>& specs, const
     row.latency_ms = o.detected ? o.latency_ms : -1.0;
     row.diagnosis = faults::diagnosis_name(o);
     row.window_s = faults::detection_window_s(o.fault);
-    for (FaultKind k : {FaultKind::Bias, FaultKind::Drift, FaultKind::NoiseBurst, FaultKind::ResolverOffset,
-                        FaultKind::TorqueLoss, FaultKind::Delay}) {
-      if (row.kind == to_string(k)) row.above_limit = std::abs(row.magnitude) >= detectability_limit(k) - 1e-9;
-    }
+    row.above_limit = above_limit(row.kind, row.magnitude, row.at_s, row.end_s);
     // Harm while undetected, from the CCU's log of the corner.
     csv::ReadOptions opt;
     opt.required = {"time_s", "force_true_kN", "command", "force_mode", "fused_kN"};
