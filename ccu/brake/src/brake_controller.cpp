@@ -32,8 +32,9 @@ void BrakeControlParams::validate() const {
   require(yaw.asymmetry_ratio > 0 && yaw.asymmetry_ratio < 1 && yaw.ramp_Nm_per_s > 0 && yaw.initial_Nm >= 0,
           "yaw: asymmetry_ratio in (0, 1), ramp_Nm_per_s > 0, initial_Nm >= 0");
   require(speed.up_gain_per_s > 0 && speed.down_gain_per_s >= 0 && speed.rolling_gain_per_s > 0 && speed.bias_gain_per_s >= 0 &&
-              speed.bias_max_wheel_accel_m_s2 > 0,
-          "speed: gains must be >= 0 (up and rolling > 0)");
+              speed.bias_max_wheel_accel_m_s2 > 0 && speed.wheel_filter_s > 0 && speed.reference_release_s >= 0 &&
+              speed.reference_window_s > 0 && speed.reference_tolerance_m_s > 0,
+          "speed: gains must be >= 0 (up and rolling > 0); filter, reference window and tolerance > 0");
   require(slip.caliper_release_kN >= 0 && slip.caliper_gap_s > 0 && slip.caliper_retract_s > 0 && slip.caliper_rate_kN_s > 0 &&
               slip.caliper_lag_s > 0 && slip.release_freeze_margin_Nm >= 0,
           "slip: caliper_release_kN, release_freeze_margin_Nm >= 0; caliper_gap_s, caliper_retract_s, caliper_rate_kN_s, caliper_lag_s > 0");
@@ -96,15 +97,20 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
     if (s.last().active) held_slip = std::min(held_slip, s.target_slip());
   }
   if (!any_active) held_slip = 0.0;
-  // The estimate follows the fastest wheel; it is held at a slip only if it is braked (its command
-  // of the last period above the free-rolling torque): an unbraked wheel reads the car's speed.
-  const std::size_t fastest =
-      static_cast<std::size_t>(std::max_element(m.wheel_rad_s.begin(), m.wheel_rad_s.end()) - m.wheel_rad_s.begin());
+  // The estimate follows the fastest wheel up; down only a wheel that rolls freely (its command
+  // at most the free-rolling torque long enough), never one under slip control (held at a slip of
+  // the estimate itself).
+  std::array<WheelBrakeStatus, 4> status{};
   for (std::size_t i = 0; i < 4; ++i) {
-    unbraked_s_[i] = out_.torque_Nm[i] > p_.speed.free_rolling_torque_Nm ? 0.0 : unbraked_s_[i] + dt_s;
+    // The pads are off once the command is at most the free-rolling torque and (with the caliper
+    // model) the model's force has reached 0 and its air gap has opened: a small command still
+    // leaves a force that holds an ice wheel at a steady slip, which is no free rolling.
+    const bool off = out_.torque_Nm[i] <= p_.speed.free_rolling_torque_Nm && (!p_.slip.caliper_model || slip_[i].model_gap() >= 1.0);
+    pads_off_s_[i] = off ? pads_off_s_[i] + dt_s : 0.0;
+    status[i].pads_off_s = pads_off_s_[i];
+    status[i].controlled = slip_[i].last().active;
   }
-  const bool fastest_braked = unbraked_s_[fastest] < p_.speed.free_rolling_s;
-  const double v = speed_.update(dt_s, m.wheel_rad_s, m.ax_m_s2, (any_active || z_request > 0.3) && fastest_braked, held_slip);
+  const double v = speed_.update(dt_s, m.wheel_rad_s, m.ax_m_s2, any_active || z_request > 0.3, held_slip, status);
   out_.speed_estimate_m_s = v;
   // Load transfer at the measured deceleration (never more than requested).
   ax_filt_ += std::min(1.0, dt_s / 0.03) * (m.ax_m_s2 - ax_filt_);

@@ -46,7 +46,9 @@ BrakeControlParams read_brake_control(Reader& r) {
     p.speed.bias_max_wheel_accel_m_s2 = c.number("bias_max_wheel_accel_m_s2", Range::positive());
     p.speed.wheel_filter_s = c.number("wheel_filter_s", Range::positive());
     p.speed.free_rolling_torque_Nm = c.number("free_rolling_torque_Nm", Range::non_negative());
-    p.speed.free_rolling_s = c.number("free_rolling_s", Range::non_negative());
+    p.speed.reference_release_s = c.number("reference_release_s", Range::non_negative());
+    p.speed.reference_window_s = c.number("reference_window_s", Range::positive());
+    p.speed.reference_tolerance_m_s = c.number("reference_tolerance_m_s", Range::positive());
     c.finish();
   }
   {

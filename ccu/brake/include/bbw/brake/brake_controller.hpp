@@ -62,7 +62,7 @@ class BrakeController {
   SpeedEstimator speed_;
   std::array<SlipController, 4> slip_;
   double ax_filt_ = 0.0;
-  std::array<double, 4> unbraked_s_{};  // how long each wheel's command has been at most free_rolling_torque_Nm
+  std::array<double, 4> pads_off_s_{};  // how long each wheel's pads have been off the disc (WheelBrakeStatus)
   static std::size_t lost_corner(const BrakeMeasurements& m);  // the one unavailable corner, else 4
   double split_s_ = 0.0;        // time since split-mu was detected
   double lost_s_ = 0.0;         // time since a lost corner's yaw limitation began

@@ -34,19 +34,27 @@ struct PedalDemandParams {
 
 struct SpeedEstimatorParams {
   double up_gain_per_s = 50.0;          // towards the fastest wheel when it reads faster
-  double down_gain_per_s = 0.5;         // towards it when it reads slower while braking hard
+  // towards it (corrected by the held slip) when it reads slower while braking hard and is not
+  // itself under slip control (a wheel under slip control never pulls the estimate down)
+  double down_gain_per_s = 0.5;
   double rolling_gain_per_s = 20.0;     // towards it when no wheel is braked hard
   double bias_gain_per_s = 0.5;         // IMU bias learning while rolling freely
   // ... only from wheel accelerations a car can have: a larger one is a sensor's first edge or a
   // dropout (the wheel-speed sensor reads 0 until its first tooth), not the car.
   double bias_max_wheel_accel_m_s2 = 15.0;
-  double wheel_filter_s = 0.005;
-  // The fastest wheel is held at a slip only while it is braked: commanded at or below this torque
-  // for free_rolling_s (time for a released wheel to spin up to the car's speed, on ice too) it
-  // rolls freely and reads the car's speed (an estimate that assumed a held slip on an unbraked
-  // wheel stayed above the car and the slip controllers released every wheel).
+  // The wheels' speeds filtered with this time constant for the reference check below.
+  double wheel_filter_s = 0.015;
+  // A reference wheel: the fastest, its pads off the disc (command at most free_rolling_torque_Nm
+  // and, with the caliper model, the model's air gap open) for reference_release_s, and spun up: over reference_window_s its speed less
+  // the IMU's integrated speed stayed within reference_tolerance_m_s of its value now. It
+  // reads the car's speed (the estimate follows it both ways at rolling_gain_per_s) and teaches
+  // the IMU's bias.
+  double reference_release_s = 0.06;
+  double reference_window_s = 0.05;
+  double reference_tolerance_m_s = 0.15;
+  // A wheel's pads are off (for the reference below) once its command is at most this torque and,
+  // with the caliper model, the model's force is 0 and its air gap open.
   double free_rolling_torque_Nm = 30.0;
-  double free_rolling_s = 0.5;
 };
 
 struct SlipControlParams {
