@@ -38,6 +38,42 @@ bbw::calibration::Estimate estimate(double force_kN, double curve_kN) {
   return e;
 }
 
+// An end-of-line monitor's parameters: the default clamp curve and a key friction of the given
+// half-width; stiff keys flip their whole width within about 0.01 rev.
+MonitorParams eol_params(double half_width_kN, bool stiff_keys) {
+  MonitorParams p;
+  p.eol_curve = bbw::plant::ClampCurveParams{};
+  bbw::plant::KeyFrictionParams k;
+  k.half_width_kN = half_width_kN;
+  if (stiff_keys) {
+    k.threshold_distribution = bbw::plant::ThresholdDistribution::LogUniform;
+    k.threshold_min_rev = 0.002;
+    k.threshold_max_rev = 0.005;
+  }
+  p.eol_key_friction = k;
+  p.eol_friction_half_width_kN = half_width_kN;
+  return p;
+}
+
+// A reading of a live resolver (noise of its quantum) at the curve's reference temperature,
+// with the current that holds the load cell's force.
+CornerReading live_reading(int n, double t, double x, double speed, double lc, const MonitorParams& p) {
+  auto r = at(static_cast<std::uint64_t>(n), t, x + 2e-5 * ((n * 7) % 3), lc);
+  r.speed_rev_per_s = speed;
+  r.temperature_C = p.eol_curve->reference_temperature_C;
+  r.motor_current_A = lc * p.Nm_per_kN / p.torque_per_A_Nm;
+  return r;
+}
+
+// The calibrator before its first fit: the load cell as it is.
+bbw::calibration::Estimate uncalibrated(double lc) {
+  bbw::calibration::Estimate e;
+  e.valid = true;
+  e.calibrated = false;
+  e.force_kN = lc;
+  return e;
+}
+
 }  // namespace
 
 TEST(SampleGuard, ClassifiesAndCountsEveryKindOfCorruptSample) {
@@ -498,14 +534,9 @@ TEST(FaultMonitor, ALoadCellStepAtStandstillIsAnOffsetAtAnyForce) {
 // healthy hold raises nothing.
 TEST(FaultMonitor, BeforeAFitTheEndOfLineFrictionModelAndTheHoldRuleFindADrift) {
   auto run = [](double drift_kN_per_s) {
-    MonitorParams p;
-    p.eol_curve = bbw::plant::ClampCurveParams{};
-    bbw::plant::KeyFrictionParams k;
-    k.half_width_kN = 1.5;
-    p.eol_key_friction = k;
-    p.eol_friction_half_width_kN = 1.5;
+    const MonitorParams p = eol_params(1.5, false);
     const bbw::plant::ClampCurve eol{*p.eol_curve};
-    bbw::plant::KeyFriction keys{k};  // the caliper's own keys, from an unknown state
+    bbw::plant::KeyFriction keys{*p.eol_key_friction};  // the caliper's own keys, from an unknown state
     keys.reset(0.0);
     const double T = p.eol_curve->reference_temperature_C;
     FaultMonitor m(p, Target::FL);
@@ -518,14 +549,8 @@ TEST(FaultMonitor, BeforeAFitTheEndOfLineFrictionModelAndTheHoldRuleFindADrift) 
       const double speed = t < 1.0 ? 4.6 : 0.0;
       const double drift_kN = t > 2.0 ? drift_kN_per_s * (t - 2.0) : 0.0;
       const double lc = eol.force_kN(x, T, 0.0) + keys.step(x) + drift_kN + 0.03 * ((n % 5) - 2);
-      auto r = at(n, t, x + 2e-5 * ((n * 7) % 3), lc);
-      r.speed_rev_per_s = speed + 0.004 * ((n % 3) - 1);
-      r.temperature_C = T;
-      r.motor_current_A = lc * p.Nm_per_kN / p.torque_per_A_Nm;
-      bbw::calibration::Estimate e;
-      e.valid = true;
-      e.calibrated = false;
-      e.force_kN = lc;
+      const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
+      const auto e = uncalibrated(lc);
       m.update(r, g.check(r), &e, lc, t);
     }
     EXPECT_NEAR(x_hold, 4.6, 0.01);
@@ -587,18 +612,10 @@ TEST(FaultMonitor, AFastReleaseWhereTheFittedCurveHasTheWrongSlopeIsNotNoise) {
 // starting band, the key-friction width + 0.5 kN) moves the load cell against both.
 TEST(FaultMonitor, CalibratedTheResidualIsJudgedAgainstBothFrictionModels) {
   auto run = [](bool two_models, double bias_kN) {
-    MonitorParams p;
-    p.eol_curve = bbw::plant::ClampCurveParams{};
-    bbw::plant::KeyFrictionParams k;
-    k.half_width_kN = 1.5;
-    k.threshold_distribution = bbw::plant::ThresholdDistribution::LogUniform;
-    k.threshold_min_rev = 0.002;  // stiff keys: the whole width flips within about 0.01 rev
-    k.threshold_max_rev = 0.005;
-    p.eol_key_friction = k;
-    p.eol_friction_half_width_kN = 1.5;
+    MonitorParams p = eol_params(1.5, true);
     p.calibrated_two_friction_models = two_models;
     const bbw::plant::ClampCurve eol{*p.eol_curve};
-    bbw::plant::KeyFriction keys{k};
+    bbw::plant::KeyFriction keys{*p.eol_key_friction};
     keys.reset(0.0);
     const double T = p.eol_curve->reference_temperature_C;
     FaultMonitor m(p, Target::FL);
@@ -611,10 +628,7 @@ TEST(FaultMonitor, CalibratedTheResidualIsJudgedAgainstBothFrictionModels) {
       x += 0.001 * speed;
       const double friction_kN = keys.step(x);
       const double lc = eol.force_kN(x, T, 0.0) + friction_kN + (t > 1.5 ? bias_kN : 0.0) + 0.03 * ((n % 5) - 2);
-      auto r = at(n, t, x + 2e-5 * ((n * 7) % 3), lc);  // a live resolver's noise
-      r.speed_rev_per_s = speed + 0.004 * ((n % 3) - 1);
-      r.temperature_C = T;
-      r.motor_current_A = lc * p.Nm_per_kN / p.torque_per_A_Nm;
+      const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
       // The calibrator: fitted from 0.5 s, its friction right in the apply and the hold, but
       // following the release's flip only over 0.1 rev.
       bbw::calibration::Estimate e;
@@ -674,17 +688,9 @@ TEST(FaultMonitor, StoppingAFastReleaseOnAViscousCaliperIsNotAChange) {
 // burst in the same cycling is still found.
 TEST(FaultMonitor, ALoadCellThatFollowsTheModelLateIsNotNoise) {
   auto run = [](double noise_rms_kN) {
-    MonitorParams p;
-    p.eol_curve = bbw::plant::ClampCurveParams{};
-    bbw::plant::KeyFrictionParams k;
-    k.half_width_kN = 1.5;
-    k.threshold_distribution = bbw::plant::ThresholdDistribution::LogUniform;
-    k.threshold_min_rev = 0.002;
-    k.threshold_max_rev = 0.005;
-    p.eol_key_friction = k;
-    p.eol_friction_half_width_kN = 1.5;
+    const MonitorParams p = eol_params(1.5, true);
     const bbw::plant::ClampCurve eol{*p.eol_curve};
-    bbw::plant::KeyFriction keys{k};
+    bbw::plant::KeyFriction keys{*p.eol_key_friction};
     keys.reset(0.0);
     const double T = p.eol_curve->reference_temperature_C;
     FaultMonitor m(p, Target::RR);
@@ -701,14 +707,8 @@ TEST(FaultMonitor, ALoadCellThatFollowsTheModelLateIsNotNoise) {
       const double model_kN = eol.force_kN(x, T, 0.0) + keys.step(x);
       const double lc = late[n % 5] + 0.03 * noise(rng) + (t > 2.0 ? noise_rms_kN * noise(rng) : 0.0);
       late[n % 5] = model_kN;
-      auto r = at(n, t, x + 2e-5 * ((n * 7) % 3), lc);
-      r.speed_rev_per_s = speed;
-      r.temperature_C = T;
-      r.motor_current_A = lc * p.Nm_per_kN / p.torque_per_A_Nm;
-      bbw::calibration::Estimate e;
-      e.valid = true;
-      e.calibrated = false;
-      e.force_kN = lc;
+      const auto r = live_reading(n, t, x, speed, lc, p);
+      const auto e = uncalibrated(lc);
       m.update(r, g.check(r), &e, lc, t);
       if (m.diagnosis(Part::LoadCell).present) break;
     }
