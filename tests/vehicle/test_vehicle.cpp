@@ -3,7 +3,9 @@
 // model, the energy balance of the brake discs, and a straight stop that stays straight.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "bbw/vehicle/tyre.hpp"
 #include "bbw/vehicle/vehicle.hpp"
@@ -163,4 +165,58 @@ TEST(VehiclePlant, RefusesBadParameters) {
   EXPECT_THROW(Vehicle(ok, r), std::invalid_argument);
   Vehicle v(ok, test::uniform_road(1, 1));
   EXPECT_THROW(v.step(0.0, {}), std::invalid_argument);
+}
+
+// Issue 15, "What is left" 3: a lower bound for the wheel lock after a dry -> ice jump at 100 km/h
+// (mu_jump_dry_to_ice_100kmh), from the plant's parameters alone. The front wheel meets the ice at
+// v, turning at u_j (the ABS's 0.10 slip on dry) with the clamp force F0 its dry tyre carried. On
+// ice the tyre carries at most T_t = mu_peak Fz R, i.e. F_t = T_t / k with k = 2 mu_pad r_eff. The
+// force stays at F0 for t_hold (detection plus the actuator's lag), then falls at r; the rim loses
+//   dv = (R k / I) (F0 - F_t) (t_hold + (F0 - F_t) / (2 r))
+// (the tyre taken at its peak throughout: the least loss), stops at u_min = max(0, u_j - dv) and
+// spins up at no more than a_s = R (T_t - f_r Fz R) / I while half the car's speed falls at a_car / 2.
+// The lock (below half the car's speed) lasts at least (v/2 - u_min) / (a_s + a_car/2): the time
+// before u_min is left out. Inputs measured in the run's vehicle.csv: v, the disc at 49 C, the
+// e-caliper's release after the command (15.3 -> 0.9 kN: 13 ms lag, then 118 kN/s on average -
+// the corner's 25 rev/s speed limit on the clamp curve's slope, 150 kN/s at 12 kN, 95 at 3 kN).
+TEST(VehiclePlant, AJumpToIceLocksTheWheelLongerThan100msWithThisCaliper) {
+  const VehicleParams p;  // config/vehicle/sedan.yaml
+  const auto& c = p.chassis;
+  const double dry = 0.8518, ice = 0.0852;  // sedan.yaml's surfaces
+  const double v = 23.99;                   // car speed at the jump (vehicle.csv, t = 0.706 s)
+  const double R = c.wheel_radius_m, I = c.wheel_inertia_kg_m2, L = c.wheelbase_m(), h = c.cg_height_m;
+  const auto front_wheel_load = [&](double decel) {
+    return 0.5 * c.mass_kg * (kG * c.cg_to_rear_axle_m + decel * h) / L;
+  };
+  const double k = 2.0 * p.front_brake.pad_mu(49.0) * p.front_brake.effective_radius_m;
+  const double fz_dry = front_wheel_load(9.45);  // the dry stop's deceleration before the jump
+  const double F0 = longitudinal_mu(p.tyre, fz_dry, 0.10, dry, dry) * fz_dry * R / k;
+  const double u_j = (1.0 - 0.10) * v;
+  const double mu_peak = peak_longitudinal_mu(p.tyre, front_wheel_load(1.0), ice, ice).mu;
+  const double a_car = mu_peak * kG + 0.5 * c.air_density_kg_m3 * c.drag_coefficient * c.frontal_area_m2 * v * v / c.mass_kg;
+  const double fz_ice = front_wheel_load(a_car);
+  const double Tt = peak_longitudinal_mu(p.tyre, fz_ice, ice, ice).mu * fz_ice * R;
+  const double Ft = Tt / k;
+  const double a_s = R * (Tt - c.rolling_resistance * fz_ice * R) / I;
+  const double closing = a_s + 0.5 * a_car;
+  const auto lock_bound = [&](double t_hold, double rate_N_s) {
+    const double dv = R * k / I * (F0 - Ft) * (t_hold + (F0 - Ft) / (2.0 * rate_N_s));
+    return std::max(0.0, 0.5 * v - std::max(0.0, u_j - dv)) / closing;
+  };
+  // The rate a release needs so that the bound allows 100 ms: dv <= u_j - v/2 + 0.1 s closing.
+  const auto rate_needed = [&](double t_hold) {
+    const double room = (u_j - 0.5 * v + 0.1 * closing) / (R * k / I) - (F0 - Ft) * t_hold;
+    return (F0 - Ft) * (F0 - Ft) / (2.0 * room);
+  };
+  const double rate = 118e3;
+  std::printf("F0 %.2f kN (k %.4f m), ice: Fz %.0f N, mu_peak %.4f, F_t %.2f kN; wheel decel %.0f m/s^2, "
+              "spin-up <= %.1f m/s^2\n", F0 / 1e3, k, fz_ice, Tt / (fz_ice * R), Ft / 1e3,
+              R * (k * F0 - Tt) / I, a_s);
+  std::printf("lock >= %.3f s (hold 26 ms, as run), %.3f s (13 ms: the lag alone), %.3f s (no hold)\n",
+              lock_bound(0.026, rate), lock_bound(0.013, rate), lock_bound(0.0, rate));
+  std::printf("rate for 100 ms: %.0f / %.0f / %.0f kN/s (hold 26 / 13 / 0 ms)\n", rate_needed(0.026) / 1e3,
+              rate_needed(0.013) / 1e3, rate_needed(0.0) / 1e3);
+  EXPECT_NEAR(F0, 15.3e3, 0.5e3);  // the run's clamp force at the jump
+  EXPECT_GT(lock_bound(0.0, rate), 0.1);  // even an instant release at this rate locks too long
+  EXPECT_GT(rate_needed(0.013), 1.5 * rate);
 }
