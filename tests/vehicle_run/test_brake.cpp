@@ -196,6 +196,32 @@ TEST(SlipController, AHighToLowMuJumpDropsTheIntegralToTheTyresTorqueAtOnce) {
   EXPECT_LT(a.update(0.005, in).torque_Nm + 500.0, b.update(0.005, in).torque_Nm);
 }
 
+TEST(SlipController, AWheelFallingFasterThanAnyTyreAllowsIsReleasedToZeroAtOnce) {
+  // 170 m/s^2 at the rim over one period, still within the slip margin (10 % -> 12.8 % at
+  // 30 m/s): the slip-margin rule waits a period; jump_hard_decel_m_s2 releases now, to 0.
+  SlipControlParams p;
+  p.jump_hard_decel_m_s2 = 160.0;
+  SlipControlParams off = p;
+  off.jump_hard_decel_m_s2 = 0.0;
+  SlipController c(p, 0.344, 1.7), o(off, 0.344, 1.7);
+  WheelInputs in;
+  in.ground_speed_m_s = 30.0;
+  in.wheel_rad_s = 0.9 * 30.0 / 0.344;
+  in.request_Nm = 2000.0;
+  in.applied_Nm = 1400.0;
+  in.load_N = 4000.0;
+  for (int i = 0; i < 40; ++i) {
+    c.update(0.005, in);
+    o.update(0.005, in);
+  }
+  ASSERT_TRUE(c.last().active);
+  in.wheel_rad_s -= 170.0 / 0.344 * 0.005;
+  EXPECT_EQ(c.update(0.005, in).torque_Nm, 0.0);
+  EXPECT_EQ(c.jump_releases(), 1u);
+  EXPECT_GT(o.update(0.005, in).torque_Nm, 500.0);
+  EXPECT_EQ(o.jump_releases(), 0u);
+}
+
 namespace {
 // A wheel just under its target slip (it could take more brake) after the pads were retracted:
 // the slip controller's torque after `periods` CCU periods, its command sent back each period as

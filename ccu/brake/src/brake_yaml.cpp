@@ -69,6 +69,7 @@ BrakeControlParams read_brake_control(Reader& r) {
     p.slip.search_threshold_mu = c.number("search_threshold_mu", Range::non_negative());
     p.slip.jump_wheel_decel_m_s2 = c.number("jump_wheel_decel_m_s2", Range::positive());
     p.slip.jump_slip_margin = c.number("jump_slip_margin", Range::closed(0, 0.5));
+    p.slip.jump_hard_decel_m_s2 = c.number("jump_hard_decel_m_s2", Range::non_negative());
     p.slip.jump_release_factor = c.number("jump_release_factor", Range::closed(0, 1));
     p.slip.active_min_clamp_kN = c.number("active_min_clamp_kN", Range::closed(0, 5));
     p.slip.caliper_model = c.boolean("caliper_model");

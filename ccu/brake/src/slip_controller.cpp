@@ -100,8 +100,15 @@ const WheelDecision& SlipController::update(double dt_s, const WheelInputs& in) 
   }
   // High-to-low mu jump: the wheel falls away faster than any braking on the old surface could
   // make it; drop the integral at once to what the tyre carries now instead of integrating down.
-  const bool falling = -w_dot_raw * radius_m_ > p_.jump_wheel_decel_m_s2 && d_.slip > target + p_.jump_slip_margin;
-  if (falling) {
+  const double rim_decel = -w_dot_raw * radius_m_;
+  const bool hard = p_.jump_hard_decel_m_s2 > 0.0 && rim_decel > p_.jump_hard_decel_m_s2;
+  const bool falling = rim_decel > p_.jump_wheel_decel_m_s2 && d_.slip > target + p_.jump_slip_margin;
+  if (hard) {
+    // Falling faster than any tyre on the old surface allows: the caliper's release (about
+    // 110 kN/s) is what sets the lock (docs/vehicle.md, "What is left" 3), so release fully.
+    integral_Nm_ = 0.0;
+    ++jumps_;
+  } else if (falling) {
     const double tyre_Nm = std::max(0.0, in.applied_Nm + inertia_kg_m2_ * w_dot_raw);
     integral_Nm_ = std::min(integral_Nm_, p_.jump_release_factor * tyre_Nm);
     ++jumps_;

@@ -79,6 +79,9 @@ struct SlipControlParams {
   // balance R Fx = T_brake + I dw/dt), times jump_release_factor.
   double jump_wheel_decel_m_s2 = 60.0;
   double jump_slip_margin = 0.05;
+  // ... or faster than this whatever its slip (0: off): no tyre on the old surface lets the wheel
+  // fall so fast, so the release need not wait the period the slip margin takes.
+  double jump_hard_decel_m_s2 = 0.0;
   double jump_release_factor = 0.8;
   // Clamp force kept while the slip controller acts (the pads stay on the disc).
   double active_min_clamp_kN = 0.3;
