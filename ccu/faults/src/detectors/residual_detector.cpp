@@ -108,7 +108,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       // At the motor's position, as the calibrator fitted its friction (the spindle's, with a
       // backlash corner's play, mixed the two and raised 6 fault-free findings on backlash corners).
       const double eol_motor_kN = x_keys_rev == r.position_rev ? eol_keys_kN : eol_->force_kN(r.position_rev, temperature_C, 0.0);
-      residual_kN_ = e.force_kN + e.friction_kN - friction_kN - eol_motor_kN;
+      const double load_cell_kN = e.force_kN + e.friction_kN;  // the calibrator's filtered load cell
+      residual_kN_ = load_cell_kN - friction_kN - eol_motor_kN;
       if (friction_known_ && p.calibrated_two_friction_models) {
         // Two models of the key friction: the calibrator's (fitted to the cycles, on the
         // motor's position) and the end-of-line one (identified on the production line, on the
@@ -117,7 +118,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
         // they bracket it: at a reversal the calibrator's elements, fitted on their own
         // thresholds, lag a friction that flips within 0.02 rev (fault-free findings on a
         // backlash corner of a non-ideal caliper, tuning seed 1403 run 601).
-        const double eol_model_kN = e.force_kN + e.friction_kN - eol_keys_kN - eol_friction_kN_;
+        const double eol_model_kN = load_cell_kN - eol_keys_kN - eol_friction_kN_;
         const double lo = std::min(residual_kN_, eol_model_kN), hi = std::max(residual_kN_, eol_model_kN);
         residual_kN_ = std::clamp(0.0, lo, hi);
       }
@@ -154,7 +155,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     reference_time_s_ = t;
   }
   change_kN_ = residual_kN_ - reference_kN_;
-  if (!eol_here && e.calibrated) {
+  const bool change_rule = !eol_here && e.calibrated;
+  if (change_rule) {
     // Unmodelled speed effects (viscous friction, sensor delay) change the residual with the
     // speed's change since the reference's level, not only with the speed: stopping a 8 rev/s
     // release on a viscous caliper moves it by 1.6 kN within 30 ms (tuning seed 1403 run 57).
@@ -169,7 +171,6 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
                                      std::abs(r.speed_rev_per_s - reference_speed_rev_per_s_) * share);
     change_thr += p.residual_speed_kN_per_rev_per_s * speed_kN;
   }
-  const bool change_rule = !eol_here && e.calibrated;
   change_threshold_kN_ = change_rule ? change_thr : std::numeric_limits<double>::quiet_NaN();
   // Hold rule: while the actuator holds (slow, within hold_span_rev of where the hold began),
   // the residual keeps the level it settled at; the curve's accuracy counts only for the
