@@ -65,6 +65,9 @@ void MonitorParams::validate() const {
   require(step_keep_fraction > 0.0 && step_keep_fraction <= 1.0, "step_keep_fraction", step_keep_fraction,
           "must be in (0, 1]");
   require(step_confirm_samples >= 1, "step_confirm_samples", step_confirm_samples, "must be >= 1");
+  require(stuck_frozen_samples >= 2, "stuck_frozen_samples", stuck_frozen_samples, "must be >= 2");
+  require(std::isfinite(stuck_frozen_run_factor) && stuck_frozen_run_factor >= 0.0, "stuck_frozen_run_factor",
+          stuck_frozen_run_factor, "must be finite and >= 0");
   require(frozen_attribution_samples >= 2, "frozen_attribution_samples", frozen_attribution_samples, "must be >= 2");
   require(noise_window_samples >= 4 && noise_window_samples <= kMaxNoiseWindow, "noise_window_samples",
           noise_window_samples, "must be in [4, 256]");

@@ -47,6 +47,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.hold_speed_rev_per_s = h.number("speed_rev_per_s", pos);
     p.hold_span_rev = h.number("span_rev", pos);
     p.hold_settle_samples = static_cast<int>(h.integer("settle_samples", 1, 100000));
+    p.hold_calibrated = h.boolean("calibrated");
     h.finish();
   }
   p.curve_min_rev = res.number("curve_min_rev");
@@ -66,6 +67,8 @@ MonitorParams read_monitor_params(Reader& r) {
   p.stuck_min_travel_rev = s.number("min_travel_rev", pos);
   p.stuck_min_force_change_kN = s.number("min_force_change_kN", pos);
   p.frozen_attribution_samples = static_cast<int>(s.integer("frozen_attribution_samples", 2, 100000));
+  p.stuck_frozen_samples = static_cast<int>(s.integer("frozen_samples", 2, 100000));
+  p.stuck_frozen_run_factor = s.number("frozen_run_factor", config::Range::closed(0.0, 1000.0));
   s.finish();
 
   auto st = r.map("step");

@@ -179,7 +179,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // (Only where the end-of-line residual is used: there its position and curve are the keys'.)
   const double x_hold = x_keys_rev;
   const double hold_curve_kN = eol_keys_kN;
-  const bool slow = eol_here && std::abs(r.speed_rev_per_s) < p.hold_speed_rev_per_s && std::isfinite(residual_kN_);
+  const bool hold_mode = eol_here || (p.hold_calibrated && eol_ && e.calibrated);
+  const bool slow = hold_mode && std::abs(r.speed_rev_per_s) < p.hold_speed_rev_per_s && std::isfinite(residual_kN_);
   // The reference belongs to one way of computing the residual: the friction model's state
   // becoming known moves the residual by the whole friction (a fault-free finding at 1.02 s,
   // scoring run 1599, before this).
@@ -206,7 +207,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     hold_change_kN_ = residual_kN_ - hold_r0_kN_;
     const double hold_thr = p.hold_kN + p.eol_relative * std::abs(hold_curve_kN - hold_f0_kN_) +
                             p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s) +
-                            (eol_here ? (friction_known_ ? p.eol_friction_model_share : 1.0) * p.eol_friction_half_width_kN : 0.0);
+                            (friction_known_ ? p.eol_friction_model_share : 1.0) * p.eol_friction_half_width_kN;
     hold_over = std::abs(hold_change_kN_) > hold_thr;
   }
   const bool over = p.residual_findings &&

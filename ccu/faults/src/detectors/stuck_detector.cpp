@@ -6,6 +6,15 @@
 
 namespace bbw::faults {
 
+namespace {
+// A run of exact repeats beyond what the channel's live noise ever gives, and beyond the run
+// factor times the longest run it ended by itself.
+bool frozen(int run, int longest_healthy_run, const MonitorParams& p) {
+  return p.stuck_frozen_run_factor > 0.0 && run >= p.stuck_frozen_samples &&
+         run >= p.stuck_frozen_run_factor * longest_healthy_run;
+}
+}  // namespace
+
 void StuckDetector::update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a) {
   if (!c.have_prev) return;
   const CornerReading& r = c.r;
@@ -23,8 +32,19 @@ void StuckDetector::update(const SampleContext& c, const MonitorParams& p, Diagn
     if (lc_repeat_ >= p.stuck_samples && run_pos_max_ - run_pos_min_ >= p.stuck_min_travel_rev) {
       a.confirm(Finding::LoadCellStuck, lc_run_onset_s_, t);
     }
+    if (frozen(lc_repeat_, longest_lc_run_, p)) a.confirm(Finding::LoadCellStuck, lc_run_onset_s_, t);
   } else {
+    if (c.check.load_cell_present) longest_lc_run_ = std::max(longest_lc_run_, lc_repeat_);  // ended by itself
     lc_repeat_ = 0;
+  }
+  // Frozen resolver: position and speed (a separate, unquantised measurement) both repeated.
+  if (r.position_rev == prev.position_rev && r.speed_rev_per_s == prev.speed_rev_per_s) {
+    if (resolver_frozen_ == 0) resolver_frozen_onset_s_ = prev.time_s;
+    ++resolver_frozen_;
+    if (frozen(resolver_frozen_, longest_resolver_run_, p)) a.confirm(Finding::ResolverStuck, resolver_frozen_onset_s_, t);
+  } else {
+    longest_resolver_run_ = std::max(longest_resolver_run_, resolver_frozen_);
+    resolver_frozen_ = 0;
   }
   // Stuck resolver: the same position again while the load cell changes.
   if (r.position_rev == prev.position_rev && c.check.load_cell_present) {

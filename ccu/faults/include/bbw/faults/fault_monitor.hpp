@@ -88,6 +88,9 @@ struct MonitorParams {
   double hold_speed_rev_per_s = 0.5;
   double hold_span_rev = 0.1;
   int hold_settle_samples = 20;
+  // The hold rule on calibrated corners too (with an end-of-line curve): the learnt residual
+  // statistics follow a slow drift the loop absorbs by creeping; the hold's level does not.
+  bool hold_calibrated = true;
   double eol_band_kN = 0.5;
   double eol_relative = 0.03;
   double eol_speed_kN_per_rev_per_s = 0.3;
@@ -120,6 +123,13 @@ struct MonitorParams {
   double stuck_min_travel_rev = 0.05;         // position range that must move a load cell
   double stuck_min_force_change_kN = 1.0;     // load-cell range that must move a resolver
   int frozen_attribution_samples = 5;
+  // Frozen at any motion: the load cell, or the resolver's position and speed together, repeated
+  // exactly over stuck_frozen_samples (a live channel's noise never repeats an unquantised value:
+  // the load cell and the speed are not quantised, the position's noise is about its quantum) and
+  // over stuck_frozen_run_factor x the longest run the channel has repeated by itself (learnt: a
+  // quantised or quiet channel repeats; 0: the rule off).
+  int stuck_frozen_samples = 20;
+  double stuck_frozen_run_factor = 3.0;
 
   // Load-cell step at standstill (StepDetector): the position within step_still_span_rev over
   // step_still_samples, then the load cell off that window's mean by step_kN and beyond
