@@ -365,6 +365,78 @@ TEST(BrakeController, TheHighSideIsReleasedAsTheDriverCounterSteers) {
 }
 
 namespace {
+// Split-mu as in split_run, held for `seconds` after the start with no steering and no yaw: the
+// high side (FR) is limited by the open-loop allowance alone (initial_Nm + ramp_Nm_per_s t, at
+// most max_ramp_Nm) above the low side's reference.
+BrakeOutput long_split_run(double max_ramp_Nm, double seconds) {
+  BrakeControlParams p;
+  p.yaw.counter_steer_gain_Nm_per_rad = 25000.0;
+  p.yaw.latch_driver_yaw_rate = true;
+  p.yaw.max_ramp_Nm = max_ramp_Nm;
+  BrakeController b(p);
+  BrakeMeasurements m;
+  for (double& w : m.wheel_rad_s) w = 20.0 / 0.344;
+  m.pedal_travel_mm = p.pedal.full_travel_mm;
+  m.pedal_force_N = p.pedal.full_force_N;
+  m.ax_m_s2 = -4.0;
+  m.wheel_rad_s[0] = 0.8 * 20.0 / 0.344;
+  m.clamp_estimate_kN = {0.3, 10.0, 0.3, 6.0};
+  for (int i = 0; i < static_cast<int>(seconds / 0.005); ++i) b.update(0.005, m);
+  EXPECT_TRUE(b.last().split_mu);
+  return b.last();
+}
+}  // namespace
+
+// Issue 15 eighth part: without a bound the open-loop ramp (400 N m/s) alone, given a few seconds,
+// grants the high side any asymmetry over the low side; max_ramp_Nm bounds it.
+TEST(BrakeController, TheHighSidesOpenLoopAllowanceSaturatesAtMaxRamp) {
+  const BrakeOutput unbounded = long_split_run(1.0e9, 3.0);
+  const BrakeOutput bounded = long_split_run(300.0, 3.0);
+  // Below the bound nothing changes (to the bit: the shipped configuration's bound is 1e9).
+  EXPECT_EQ(long_split_run(1000.0, 0.3).torque_Nm[1], long_split_run(1.0e9, 0.3).torque_Nm[1]);
+  // FL's reference (its command, at least 0.8 of its tyre's torque) is the same both ways.
+  EXPECT_NEAR(bounded.torque_Nm[0], unbounded.torque_Nm[0], 1e-6);
+  // FL's tyre carries next to nothing at its 0.3 kN: the low side's reference is within 50 N m of it.
+  EXPECT_LE(bounded.torque_Nm[1], bounded.torque_Nm[0] + 300.0 + 50.0) << bounded.torque_Nm[1] << " " << bounded.torque_Nm[0];
+  EXPECT_GT(unbounded.torque_Nm[1], bounded.torque_Nm[1] + 500.0) << unbounded.torque_Nm[1];
+}
+
+// Issue 15 eighth part: the yaw-moment build-up delay before the split is seen (GMA). FL goes into
+// slip control while FR rolls with 3 kN applied; the split detection is kept from firing (its mu
+// difference set out of reach) so the hold alone acts: FR may rise from its applied torque at the
+// hold's rate only, and without the hold it gets the driver's request.
+TEST(BrakeController, BeforeTheSplitIsSeenTheHighSideIsHeldWhileOnlyItsPartnerIsUnderSlipControl) {
+  auto run = [](double pre_ramp) {
+    BrakeControlParams p;
+    p.yaw.min_mu_difference = 1.0;  // no split detection
+    p.yaw.pre_split_ramp_Nm_per_s = pre_ramp;
+    BrakeController b(p);
+    BrakeMeasurements m;
+    for (double& w : m.wheel_rad_s) w = 20.0 / 0.344;
+    m.pedal_travel_mm = p.pedal.full_travel_mm;
+    m.pedal_force_N = p.pedal.full_force_N;
+    m.ax_m_s2 = -4.0;
+    m.wheel_rad_s[0] = 0.8 * 20.0 / 0.344;
+    m.wheel_rad_s[2] = 0.8 * 20.0 / 0.344;
+    m.clamp_estimate_kN = {0.3, 3.0, 0.3, 3.0};
+    for (int i = 0; i < 20; ++i) b.update(0.005, m);  // 0.1 s
+    EXPECT_TRUE(b.last().wheels[0].active);
+    EXPECT_FALSE(b.last().wheels[1].active);
+    EXPECT_FALSE(b.last().split_mu);
+    return std::make_pair(b.last(), b.torque_Nm(1, 3.0));
+  };
+  const auto [held, applied_Nm] = run(2000.0);
+  const auto [free, unused] = run(0.0);
+  (void)unused;
+  EXPECT_LE(held.torque_Nm[1], applied_Nm + 2000.0 * 0.1 + 1e-6) << held.torque_Nm[1];
+  EXPECT_GE(held.torque_Nm[1], applied_Nm) << held.torque_Nm[1];
+  EXPECT_GT(free.torque_Nm[1], held.torque_Nm[1] + 300.0) << free.torque_Nm[1];
+  // The rear axle likewise (RL under slip control, RR held).
+  EXPECT_LE(held.torque_Nm[3], held.torque_Nm[1]);
+  EXPECT_GT(free.torque_Nm[3], held.torque_Nm[3] + 100.0) << free.torque_Nm[3];
+}
+
+namespace {
 // The end of a low-mu stop at full pedal: the estimate stands above the car (3.3 m/s) while the
 // wheels roll at the car's 2.5 m/s (ax -0.1 m/s^2: next to no braking).
 BrakeOutput rolling_run(double reference_release_s) {

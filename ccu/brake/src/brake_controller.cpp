@@ -229,7 +229,11 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
       const double heading_towards_high = heading_error_rad_;
       // The driver's counter-steer (towards the low side, left positive) since the split was seen.
       const double counter_steer = (low_side == 0 ? 1.0 : -1.0) * (m.steer_rad - brake_steer_rad_);
-      const double allowed = std::max(lo, lo + p_.yaw.initial_Nm + p_.yaw.ramp_Nm_per_s * split_s_ +
+      // The open-loop part, saturating at max_ramp_Nm (written so that below it the sum is the same
+      // floating-point expression as before the bound).
+      const bool saturated = p_.yaw.initial_Nm + p_.yaw.ramp_Nm_per_s * split_s_ > p_.yaw.max_ramp_Nm;
+      const double open_loop = saturated ? lo + p_.yaw.max_ramp_Nm : lo + p_.yaw.initial_Nm + p_.yaw.ramp_Nm_per_s * split_s_;
+      const double allowed = std::max(lo, open_loop +
                                               p_.yaw.counter_steer_gain_Nm_per_rad * std::max(0.0, counter_steer) -
                                               p_.yaw.yaw_error_gain_Nm_per_rad_s * std::max(0.0, towards_high) -
                                               p_.yaw.heading_error_gain_Nm_per_rad * heading_towards_high);
@@ -239,6 +243,37 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
         const double rear = std::max(out_.torque_Nm[rear_low], p_.yaw.low_side_capacity_share * capacity(rear_low));
         out_.torque_Nm[2] = std::min(out_.torque_Nm[2], rear);
         out_.torque_Nm[3] = std::min(out_.torque_Nm[3], rear);
+      }
+    }
+    // Yaw-moment build-up delay before the split is seen (GMA): the first time in a stop that one
+    // wheel of an axle goes into slip control while its partner does not, the partner is held at
+    // the torque its caliper applies then and rises at most at pre_split_ramp_Nm_per_s until it
+    // also goes into slip control or the split is seen. On a uniform road the partner follows
+    // within a few periods; on split-mu the high side's force no longer builds up while the
+    // detection waits for the tyres' mu estimates to part.
+    if (p_.yaw.pre_split_ramp_Nm_per_s > 0.0) {
+      for (std::size_t axle = 0; axle < 2; ++axle) {
+        PreSplitHold& h = pre_[axle];
+        const std::size_t a = 2 * axle, b = a + 1;
+        if (split_ || z_request <= 0.0) {
+          h.holding = false;
+        } else if (!h.holding && !h.done && m.available[a] && m.available[b] &&
+                   out_.wheels[a].active != out_.wheels[b].active) {
+          h.holding = true;
+          h.done = true;
+          h.wheel = out_.wheels[a].active ? b : a;
+          h.s = 0.0;
+          h.hold_Nm = torque_Nm(h.wheel, std::max(0.0, m.clamp_estimate_kN[h.wheel]));
+        }
+        if (h.holding) {
+          if (out_.wheels[h.wheel].active) {
+            h.holding = false;
+          } else {
+            h.s += dt_s;
+            out_.torque_Nm[h.wheel] = std::min(out_.torque_Nm[h.wheel], h.hold_Nm + p_.yaw.pre_split_ramp_Nm_per_s * h.s);
+          }
+        }
+        if (z_request <= 0.0) h.done = false;
       }
     }
     if (z_request <= 0.0) split_ = false;

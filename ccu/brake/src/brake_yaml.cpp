@@ -92,6 +92,8 @@ BrakeControlParams read_brake_control(Reader& r) {
     p.yaw.yaw_error_gain_Nm_per_rad_s = c.number("yaw_error_gain_Nm_per_rad_s", Range::non_negative());
     p.yaw.heading_error_gain_Nm_per_rad = c.number("heading_error_gain_Nm_per_rad", Range::non_negative());
     p.yaw.counter_steer_gain_Nm_per_rad = c.number("counter_steer_gain_Nm_per_rad", Range::non_negative());
+    p.yaw.max_ramp_Nm = c.number("max_ramp_Nm", Range::non_negative());
+    p.yaw.pre_split_ramp_Nm_per_s = c.number("pre_split_ramp_Nm_per_s", Range::non_negative());
     p.yaw.latch_driver_yaw_rate = c.boolean("latch_driver_yaw_rate");
     p.yaw.rear_select_low = c.boolean("rear_select_low");
     p.yaw.low_side_capacity_share = c.number("low_side_capacity_share", Range::closed(0, 1));

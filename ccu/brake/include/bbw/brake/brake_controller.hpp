@@ -71,6 +71,15 @@ class BrakeController {
   double brake_steer_rad_ = 0.0;        // the steering angle when the split was seen
   double brake_driver_yaw_rate_ = 0.0;  // the driver's yaw rate when the split was seen  // yaw-rate error integrated while split_
   std::size_t low_side_ = 0;    // the front wheel on the low mu, latched while split_
+  // Per axle, the yaw-moment build-up delay before the split is seen (pre_split_ramp_Nm_per_s).
+  struct PreSplitHold {
+    bool holding = false;
+    bool done = false;          // once per stop
+    std::size_t wheel = 0;      // the wheel held (its partner is under slip control)
+    double s = 0.0;             // time held
+    double hold_Nm = 0.0;       // its applied torque when the hold began
+  };
+  std::array<PreSplitHold, 2> pre_{};
   BrakeOutput out_;
 };
 

@@ -118,6 +118,14 @@ struct YawLimitParams {
   // torque per rad of road-wheel steering towards the low side since the split was seen (the
   // moment a counter-steer balances: 2 R l_f C_f / t_f per rad).
   double counter_steer_gain_Nm_per_rad = 0.0;
+  // The open-loop part of the high side's allowance (initial_Nm + ramp_Nm_per_s t) saturates here
+  // (issue 15 eighth part): without a bound the ramp alone, given time, grants any asymmetry.
+  double max_ramp_Nm = 1.0e9;
+  // Yaw-moment build-up delay before the split is seen (GMA): once one front wheel goes into slip
+  // control while the other is not, the other's torque is held at what its caliper applies then
+  // and may rise only at this rate until it also goes into slip control or the split is seen
+  // (0: off).
+  double pre_split_ramp_Nm_per_s = 0.0;
   // Reference yaw rate latched when the split is seen (true) or the driver's steering now (false).
   bool latch_driver_yaw_rate = false;
   bool rear_select_low = true;
