@@ -46,6 +46,7 @@ void ControllerParams::validate() const {
   positive("stiffness_memory_rev", stiffness_memory_rev);
   non_negative("stiffness_reversal_rev", stiffness_reversal_rev);
   positive("stiffness_hold_rev", stiffness_hold_rev);
+  if (frozen_resolver_samples < 0) throw std::invalid_argument("frozen_resolver_samples must be >= 0 (0: off)");
   if (!(std::isfinite(stiffness_max_ratio) && stiffness_max_ratio >= 1.0)) {
     std::ostringstream os;
     os << "stiffness_max_ratio = " << stiffness_max_ratio << ": must be >= 1";
@@ -99,9 +100,24 @@ ControllerOutput LocalController::speed_loop(double v_ref, double a_ff, const Co
   return ControllerOutput{cmd, v_ref, sat};
 }
 
+bool LocalController::resolver_frozen(const ControllerInputs& in) {
+  const bool same = in.position_rev == s_.last_position_rev && in.speed_rev_per_s == s_.last_speed_rev_per_s;
+  s_.resolver_repeats = same ? s_.resolver_repeats + 1 : 0;
+  s_.last_position_rev = in.position_rev;
+  s_.last_speed_rev_per_s = in.speed_rev_per_s;
+  s_.resolver_frozen = p_.frozen_resolver_samples > 0 && s_.resolver_repeats >= p_.frozen_resolver_samples;
+  if (s_.resolver_frozen) {
+    s_.speed_integral_A = 0.0;
+    s_.force_integral_kN_s = 0.0;
+    s_.stiffness.started = false;
+  }
+  return s_.resolver_frozen;
+}
+
 ControllerOutput LocalController::update_position(const PositionReference& ref, const ControllerInputs& in,
                                                   double dt_s) {
   if (!(dt_s > 0.0)) return ControllerOutput{};
+  if (resolver_frozen(in)) return ControllerOutput{};
   const double unclipped = ref.speed_rev_per_s + p_.position_gain_per_s * (ref.position_rev - in.position_rev);
   const double v_ref = std::clamp(unclipped, -p_.max_speed_rev_per_s, p_.max_speed_rev_per_s);
   const double a_ff = v_ref == unclipped ? ref.accel_rev_per_s2 : 0.0;
@@ -153,6 +169,7 @@ ControllerOutput LocalController::update_force(double force_command_kN, const Co
     return update_position(PositionReference{p_.release_position_rev, 0.0, 0.0}, in, dt_s);
   }
   s_.releasing = false;
+  if (resolver_frozen(in)) return ControllerOutput{};
   const double e = force_command_kN - in.force_feedback_kN;
   update_stiffness(p_.stiffness_at_zero_kN_per_rev + p_.stiffness_per_kN_per_rev * std::max(in.force_feedback_kN, 0.0),
                    in);

@@ -172,6 +172,7 @@ corner_unit::ControllerParams read_controller(Reader& c) {
   p.stiffness_reversal_rev = c.number_or("stiffness_reversal_rev", p.stiffness_reversal_rev, Range::non_negative());
   p.stiffness_hold_rev = c.number_or("stiffness_hold_rev", p.stiffness_hold_rev, Range::positive());
   p.stiffness_max_ratio = c.number_or("stiffness_max_ratio", p.stiffness_max_ratio, Range::closed(1.0, 1.0e4));
+  p.frozen_resolver_samples = static_cast<int>(c.integer_or("frozen_resolver_samples", p.frozen_resolver_samples, 0, 100000));
   c.finish();
   return p;
 }

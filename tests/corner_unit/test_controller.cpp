@@ -202,3 +202,42 @@ TEST(Controller, RejectsInvalidParameters) {
   EXPECT_THROW(corner_unit::LocalController{p}, std::invalid_argument);
   EXPECT_NO_THROW(corner_unit::LocalController{corner_unit::ControllerParams{}});
 }
+
+// A frozen resolver (its position and speed repeated exactly, as a stuck resolver delivers them):
+// the motor cannot be commutated and the speed loop has no feedback. The controller drives no
+// current while it lasts (before: the speed loop wound up and the caliper oscillated to hundreds
+// of kN, tuning seed 1403 run 34), and controls again once the resolver lives.
+TEST(ForceMode, AFrozenResolverDrivesNoCurrentUntilItLivesAgain) {
+  // Held at 10 kN, the resolver freezes at 1.0 s, the command steps to 20 kN at 1.2 s, the
+  // resolver lives again at 2.0 s.
+  auto run = [](int frozen_samples) {
+    Loop l;
+    auto p = params_for(l.pp);
+    p.frozen_resolver_samples = frozen_samples;
+    l.ctl = corner_unit::LocalController{p};
+    double max_frozen_kN = 0.0, max_current_while_frozen_A = 0.0;
+    corner_unit::ControllerInputs held;
+    for (int k = 0; k < 3500; ++k) {
+      auto in = l.inputs(corner_unit::ForceFeedback::LoadCell);
+      const bool frozen = k >= 1000 && k < 2000;
+      if (k == 1000) held = in;
+      if (frozen) {
+        in.position_rev = held.position_rev;
+        in.speed_rev_per_s = held.speed_rev_per_s;
+      }
+      const auto out = l.ctl.update_force(k < 1200 ? 10.0 : 20.0, in, kDt);
+      if (frozen && k >= 1000 + frozen_samples) {
+        max_current_while_frozen_A = std::max(max_current_while_frozen_A, std::abs(out.current_command_A));
+      }
+      l.apply(out.current_command_A);
+      if (frozen) max_frozen_kN = std::max(max_frozen_kN, l.plant.state().force_true_kN);
+    }
+    return std::tuple{max_frozen_kN, max_current_while_frozen_A, l.plant.state().force_true_kN};
+  };
+  const auto [max_kN, frozen_A, end_kN] = run(20);
+  EXPECT_EQ(frozen_A, 0.0);
+  EXPECT_LT(max_kN, 12.0);              // holds about where it froze
+  EXPECT_NEAR(end_kN, 20.0, 1.0);       // controls again after it
+  const auto [off_max_kN, off_A, off_end_kN] = run(0);  // the rule off: the speed loop winds up
+  EXPECT_GT(off_max_kN, 25.0) << off_A << " " << off_end_kN;  // 33 kN against a 20 kN command
+}

@@ -350,7 +350,7 @@ TEST(FaultMonitor, TorqueBalanceSeparatesPartialAndTotalLoss) {
 // above the commanded response by the tracking threshold; one that moves back (releasing, if
 // slowly) or that holds what it is told is not.
 TEST(FaultMonitor, ABrakeThatDoesNotReleaseIsNamedAndOneThatMovesBackIsNot) {
-  MonitorParams p;
+  MonitorParams p = noiseless();
   SampleCheck ok;
   auto run = [&](double command_kN, double speed_rev_per_s, double until_s) {
     FaultMonitor m(p, Target::FL);
@@ -379,7 +379,7 @@ TEST(FaultMonitor, ABrakeThatDoesNotReleaseIsNamedAndOneThatMovesBackIsNot) {
 // A part's finding is upgraded to not releasing (and finding_s records when); the first
 // detection time stays.
 TEST(FaultMonitor, ALostActuatorThatDoesNotReleaseIsUpgraded) {
-  MonitorParams p;
+  MonitorParams p = noiseless();
   SampleCheck ok;
   FaultMonitor m(p, Target::FL);
   int k = 1;

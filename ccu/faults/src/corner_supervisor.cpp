@@ -198,11 +198,15 @@ void CornerSupervisor::refresh_view(const CornerReading* r, const SampleCheck* c
     view_.source = EstimateSource::None;
   }
   const Diagnosis& act = monitor_.diagnosis(Part::Actuator);
-  const bool actuator_usable = !act.active || act.finding == Finding::ActuatorTorqueLoss;
+  const Diagnosis& res = monitor_.diagnosis(Part::Resolver);
+  // A stuck resolver: the corner cannot commutate its motor (it drives no current) and holds
+  // whatever force it has, like an actuator that does not release.
+  const bool commutation_lost = res.active && res.finding == Finding::ResolverStuck;
+  const bool actuator_usable = (!act.active || act.finding == Finding::ActuatorTorqueLoss) && !commutation_lost;
   const bool sensing = lc_ok || res_ok;
   view_.available = linked && actuator_usable && sensing;
   view_.force_limit_kN = monitor_.params().force_limit_kN;
-  const bool holding = act.active && act.finding == Finding::ActuatorNotReleasing;
+  const bool holding = (act.active && act.finding == Finding::ActuatorNotReleasing) || commutation_lost;
   view_.held_kN = holding && std::isfinite(view_.force_estimate_kN) ? std::max(0.0, view_.force_estimate_kN) : 0.0;
   if (!lc_ok && res_ok) {
     view_.feedback = corner_unit::ForceFeedback::Curve;

@@ -53,6 +53,12 @@ struct ControllerParams {
   // where the slope it sees is 0 until the flank meets sticking friction) keeps the low gain the
   // stiff side needs. The rate feedforward divides by the current estimate.
   double stiffness_hold_rev = 0.1;
+  // A resolver whose position and speed both repeat exactly over this many samples is frozen
+  // (a live resolver's speed is noisy and never repeats): the motor cannot be commutated and
+  // the speed loop has no feedback, so the current is 0 until the resolver lives again (without
+  // this a stuck resolver wound the speed loop up and drove the caliper into an oscillation of
+  // hundreds of kN, tuning seed 1403 run 34). 0: off.
+  int frozen_resolver_samples = 20;
 
   void validate() const;  // throws std::invalid_argument naming the field
 };
@@ -100,6 +106,10 @@ struct ControllerState {
   double force_integral_kN_s = 0.0;
   bool releasing = true;               // force mode below release_force_kN
   StiffnessEstimate stiffness;
+  // The resolver's last reading and how often it has repeated exactly (position and speed).
+  double last_position_rev = 0.0, last_speed_rev_per_s = 0.0;
+  int resolver_repeats = 0;
+  bool resolver_frozen = false;        // the current is 0 (see frozen_resolver_samples)
 };
 
 struct ControllerOutput {
@@ -123,6 +133,8 @@ class LocalController {
 
  private:
   ControllerOutput speed_loop(double v_ref, double a_ff, const ControllerInputs& in, double dt_s);
+  // Counts the resolver's exact repeats; true (and the loops' integrators reset) while frozen.
+  bool resolver_frozen(const ControllerInputs& in);
   // Updates the estimate: s_.stiffness.stiffness_kN_per_rev (feedforward) and held_kN_per_rev
   // (feedback), both >= the model.
   void update_stiffness(double model_kN_per_rev, const ControllerInputs& in);
