@@ -141,6 +141,35 @@ TEST(SlipController, PassesTheDriverThroughBelowTheTargetAndLimitsAbove) {
   EXPECT_LT(c.last().torque_Nm, 2500.0);
 }
 
+// The tyre's mu from the wheel's torque balance R Fx = T + I dw/dt must not lag in one term only:
+// an ice wheel whose brake torque swings +-50 N m at 5 Hz (its limit cycle) while the tyre carries
+// a constant force. Before issue 15's ninth part the inertia term was filtered twice (w_dot_, then
+// mu_), the brake torque once: the estimate swung by about +-0.02 (a fifth of the ice tyre's mu)
+// against the slip, and the target search went to its floor (docs/vehicle.md).
+TEST(SlipController, TheTyresMuEstimateDoesNotSwingWithTheBrakeTorqueAtAConstantTyreForce) {
+  SlipControlParams p;
+  const double R = 0.344, I = 1.7, load = 3000.0, mu = 0.1, dt = 0.005;
+  SlipController c(p, R, I);
+  const double tyre_Nm = R * mu * load;  // 103.2 N m
+  double w = 50.0, t_prev = tyre_Nm;
+  double worst = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    // The wheel over the last period under the torque that acted on it (the CCU's applied estimate).
+    w += dt * (tyre_Nm - t_prev) / I;
+    WheelInputs in;
+    in.wheel_rad_s = w;
+    in.ground_speed_m_s = 0.9 * 50.0 * R;
+    in.request_Nm = 0.0;  // the estimate runs whether or not the controller acts
+    in.applied_Nm = t_prev;
+    in.load_N = load;
+    c.update(dt, in);
+    if (k > 100) worst = std::max(worst, std::abs(c.last().mu_estimate - mu));
+    t_prev = tyre_Nm + 50.0 * std::sin(2.0 * M_PI * 5.0 * (k + 1) * dt);
+  }
+  std::printf("mu estimate's worst error %.4f (tyre mu %.2f)\n", worst, mu);
+  EXPECT_LT(worst, 0.005);
+}
+
 TEST(BrakeController, DistributesWithLoadTransferAndRefusesBadParams) {
   BrakeControlParams p;
   p.abs_enabled = false;

@@ -68,8 +68,12 @@ const WheelDecision& SlipController::update(double dt_s, const WheelInputs& in) 
   const double v = in.ground_speed_m_s;
   d_.slip = v > 0.5 ? std::clamp(1.0 - radius_m_ * w_filt_ / v, -1.0, 1.0) : 0.0;
   // Tyre mu from the wheel's torque balance: R Fx = T_brake + I dw/dt (braking Fx > 0 here).
+  // Both terms with the same lag (one mu filter): the inertia term from the period's own
+  // deceleration, not from w_dot_ (already filtered once - filtered twice it lagged the brake
+  // torque, and on ice, where it is as large as the tyre's torque, the estimate fell as the slip
+  // rose and the target search ran to its floor; docs/vehicle.md, issue 15 ninth part).
   if (in.load_N > 0.0) {
-    const double mu_raw = (in.applied_Nm + inertia_kg_m2_ * w_dot_) / (radius_m_ * in.load_N);
+    const double mu_raw = (in.applied_Nm + inertia_kg_m2_ * w_dot_raw) / (radius_m_ * in.load_N);
     mu_ += b * (mu_raw - mu_);
   }
   d_.mu_estimate = mu_;
