@@ -55,6 +55,18 @@ MonitorParams eol_params(double half_width_kN, bool stiff_keys) {
   return p;
 }
 
+// The caliper an end-of-line monitor describes: its clamp curve, its own keys (relaxed at 0) and
+// the curve's reference temperature.
+struct EolCaliper {
+  bbw::plant::ClampCurve curve;
+  bbw::plant::KeyFriction keys;
+  double T;
+  explicit EolCaliper(const MonitorParams& p)
+      : curve{*p.eol_curve}, keys{*p.eol_key_friction}, T{p.eol_curve->reference_temperature_C} {
+    keys.reset(0.0);
+  }
+};
+
 // A reading of a live resolver (noise of its quantum) at the curve's reference temperature,
 // with the current that holds the load cell's force.
 CornerReading live_reading(int n, double t, double x, double speed, double lc, const MonitorParams& p) {
@@ -590,10 +602,8 @@ TEST(FaultMonitor, ALoadCellStepAtStandstillIsAnOffsetAtAnyForce) {
 TEST(FaultMonitor, BeforeAFitTheEndOfLineFrictionModelAndTheHoldRuleFindADrift) {
   auto run = [](double drift_kN_per_s) {
     const MonitorParams p = eol_params(1.5, false);
-    const bbw::plant::ClampCurve eol{*p.eol_curve};
-    bbw::plant::KeyFriction keys{*p.eol_key_friction};  // the caliper's own keys, from an unknown state
-    keys.reset(0.0);
-    const double T = p.eol_curve->reference_temperature_C;
+    EolCaliper caliper{p};  // the caliper's own keys, from an unknown state
+    auto& [eol, keys, T] = caliper;
     FaultMonitor m(p, Target::FL);
     SampleGuard g{MonitorParams{}.guard};
     double x = 0.0, x_hold = 0.0;
@@ -671,10 +681,8 @@ TEST(FaultMonitor, CalibratedTheResidualIsJudgedAgainstBothFrictionModels) {
   auto run = [](bool two_models, double bias_kN) {
     MonitorParams p = eol_params(1.5, true);
     p.calibrated_two_friction_models = two_models;
-    const bbw::plant::ClampCurve eol{*p.eol_curve};
-    bbw::plant::KeyFriction keys{*p.eol_key_friction};
-    keys.reset(0.0);
-    const double T = p.eol_curve->reference_temperature_C;
+    EolCaliper caliper{p};  // the caliper's own keys, from an unknown state
+    auto& [eol, keys, T] = caliper;
     FaultMonitor m(p, Target::FL);
     SampleGuard g{MonitorParams{}.guard};
     double x = 0.0;
@@ -746,10 +754,8 @@ TEST(FaultMonitor, StoppingAFastReleaseOnAViscousCaliperIsNotAChange) {
 TEST(FaultMonitor, ALoadCellThatFollowsTheModelLateIsNotNoise) {
   auto run = [](double noise_rms_kN) {
     const MonitorParams p = eol_params(1.5, true);
-    const bbw::plant::ClampCurve eol{*p.eol_curve};
-    bbw::plant::KeyFriction keys{*p.eol_key_friction};
-    keys.reset(0.0);
-    const double T = p.eol_curve->reference_temperature_C;
+    EolCaliper caliper{p};  // the caliper's own keys, from an unknown state
+    auto& [eol, keys, T] = caliper;
     FaultMonitor m(p, Target::RR);
     SampleGuard g{MonitorParams{}.guard};
     std::mt19937_64 rng(11);
@@ -788,10 +794,8 @@ TEST(FaultMonitor, CalibratedAHoldKeepsItsLevelWhileTheLearntStatisticsFollowADr
   auto run = [](bool hold_calibrated, double drift_kN_per_s) {
     MonitorParams p = eol_params(1.5, false);
     p.hold_calibrated = hold_calibrated;
-    const bbw::plant::ClampCurve eol{*p.eol_curve};
-    bbw::plant::KeyFriction keys{*p.eol_key_friction};
-    keys.reset(0.0);
-    const double T = p.eol_curve->reference_temperature_C;
+    EolCaliper caliper{p};  // the caliper's own keys, from an unknown state
+    auto& [eol, keys, T] = caliper;
     FaultMonitor m(p, Target::RL);
     SampleGuard g{MonitorParams{}.guard};
     double x = 0.0;

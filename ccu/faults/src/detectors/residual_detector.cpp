@@ -176,7 +176,9 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // the residual keeps the level it settled at; the curve's accuracy counts only for the
   // force the position moved through, the friction model's for its share of the width. A
   // slow load-cell drift the force loop follows by creeping shows here, not in the level.
-  // (Only where the end-of-line residual is used: there its position and curve are the keys'.)
+  // Wherever the residual is against the end-of-line curve (its position and curve are the keys'):
+  // before a credible fit and, with hold.calibrated, after it (the learnt statistics follow a
+  // slow drift there; the hold's level does not).
   const double x_hold = x_keys_rev;
   const double hold_curve_kN = eol_keys_kN;
   const bool hold_mode = eol_here || (p.hold_calibrated && eol_ && e.calibrated);
