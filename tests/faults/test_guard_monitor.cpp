@@ -77,6 +77,18 @@ CornerReading live_reading(int n, double t, double x, double speed, double lc, c
   return r;
 }
 
+// The calibrator once `calibrated`: its friction estimate and curve at the position, the load
+// cell less its friction as the force.
+bbw::calibration::Estimate fitted(bool calibrated, double lc_kN, double friction_kN, double curve_kN) {
+  bbw::calibration::Estimate e;
+  e.valid = true;
+  e.calibrated = calibrated;
+  e.friction_kN = friction_kN;
+  e.force_kN = lc_kN - friction_kN;
+  e.curve_force_kN = curve_kN;
+  return e;
+}
+
 // The calibrator before its first fit: the load cell as it is.
 bbw::calibration::Estimate uncalibrated(double lc) {
   bbw::calibration::Estimate e;
@@ -696,13 +708,8 @@ TEST(FaultMonitor, CalibratedTheResidualIsJudgedAgainstBothFrictionModels) {
       const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
       // The calibrator: fitted from 0.5 s, its friction right in the apply and the hold, but
       // following the release's flip only over 0.1 rev.
-      bbw::calibration::Estimate e;
-      e.valid = true;
-      e.calibrated = t > 0.5;
       const double lag_kN = t < 2.0 ? 1.5 : std::max(-1.5, 1.5 - 30.0 * (t - 2.0));
-      e.friction_kN = t < 2.0 ? friction_kN : lag_kN;
-      e.force_kN = lc - e.friction_kN;
-      e.curve_force_kN = eol.force_kN(x, T, 0.0);
+      const auto e = fitted(t > 0.5, lc, t < 2.0 ? friction_kN : lag_kN, eol.force_kN(x, T, 0.0));
       m.update(r, g.check(r), &e, e.force_kN, t);
     }
     return m.diagnosis(Part::LoadCell);
@@ -807,12 +814,7 @@ TEST(FaultMonitor, CalibratedAHoldKeepsItsLevelWhileTheLearntStatisticsFollowADr
       const double drift_kN = t > 4.0 ? drift_kN_per_s * (t - 4.0) : 0.0;
       const double lc = eol.force_kN(x, T, 0.0) + friction_kN + drift_kN + 0.03 * ((n % 5) - 2);
       const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
-      bbw::calibration::Estimate e;  // fitted from 0.5 s, its friction right
-      e.valid = true;
-      e.calibrated = t > 0.5;
-      e.friction_kN = friction_kN;
-      e.force_kN = lc - friction_kN;
-      e.curve_force_kN = eol.force_kN(x, T, 0.0);
+      const auto e = fitted(t > 0.5, lc, friction_kN, eol.force_kN(x, T, 0.0));  // its friction right
       m.update(r, g.check(r), &e, e.force_kN, t);
     }
     return m.diagnosis(Part::LoadCell);

@@ -358,6 +358,17 @@ TEST(BrakeController, ALostCornersShareGoesToTheSameSideWheelOfTheOtherAxle) {
 }
 
 namespace {
+// Full pedal at 20 m/s, the car decelerating at 4 m/s^2, FL slipping 20 % (the others roll).
+BrakeMeasurements fl_slipping_at_full_pedal(const BrakeControlParams& p) {
+  BrakeMeasurements m;
+  for (double& w : m.wheel_rad_s) w = 20.0 / 0.344;
+  m.pedal_travel_mm = p.pedal.full_travel_mm;
+  m.pedal_force_N = p.pedal.full_force_N;
+  m.ax_m_s2 = -4.0;
+  m.wheel_rad_s[0] = 0.8 * 20.0 / 0.344;
+  return m;
+}
+
 // Split-mu, FL on ice: FL slips 20 % with next to no torque, FR rolls with the driver's torque and
 // a tyre that carries it. steer_rad: the driver's steering (left positive) from the start.
 BrakeOutput split_run(double steer_rad, double counter_steer_gain) {
@@ -365,12 +376,7 @@ BrakeOutput split_run(double steer_rad, double counter_steer_gain) {
   p.yaw.counter_steer_gain_Nm_per_rad = counter_steer_gain;
   p.yaw.latch_driver_yaw_rate = true;  // as shipped (config/vehicle/brake_control.yaml)
   BrakeController b(p);
-  BrakeMeasurements m;
-  for (double& w : m.wheel_rad_s) w = 20.0 / 0.344;
-  m.pedal_travel_mm = p.pedal.full_travel_mm;
-  m.pedal_force_N = p.pedal.full_force_N;
-  m.ax_m_s2 = -4.0;
-  m.wheel_rad_s[0] = 0.8 * 20.0 / 0.344;
+  BrakeMeasurements m = fl_slipping_at_full_pedal(p);
   m.clamp_estimate_kN = {0.3, 10.0, 0.3, 6.0};
   for (int i = 0; i < 60; ++i) b.update(0.005, m);
   EXPECT_TRUE(b.last().split_mu);
@@ -403,12 +409,7 @@ BrakeOutput long_split_run(double max_ramp_Nm, double seconds) {
   p.yaw.latch_driver_yaw_rate = true;
   p.yaw.max_ramp_Nm = max_ramp_Nm;
   BrakeController b(p);
-  BrakeMeasurements m;
-  for (double& w : m.wheel_rad_s) w = 20.0 / 0.344;
-  m.pedal_travel_mm = p.pedal.full_travel_mm;
-  m.pedal_force_N = p.pedal.full_force_N;
-  m.ax_m_s2 = -4.0;
-  m.wheel_rad_s[0] = 0.8 * 20.0 / 0.344;
+  BrakeMeasurements m = fl_slipping_at_full_pedal(p);
   m.clamp_estimate_kN = {0.3, 10.0, 0.3, 6.0};
   for (int i = 0; i < static_cast<int>(seconds / 0.005); ++i) b.update(0.005, m);
   EXPECT_TRUE(b.last().split_mu);
@@ -440,12 +441,7 @@ TEST(BrakeController, BeforeTheSplitIsSeenTheHighSideIsHeldWhileOnlyItsPartnerIs
     p.yaw.min_mu_difference = 1.0;  // no split detection
     p.yaw.pre_split_ramp_Nm_per_s = pre_ramp;
     BrakeController b(p);
-    BrakeMeasurements m;
-    for (double& w : m.wheel_rad_s) w = 20.0 / 0.344;
-    m.pedal_travel_mm = p.pedal.full_travel_mm;
-    m.pedal_force_N = p.pedal.full_force_N;
-    m.ax_m_s2 = -4.0;
-    m.wheel_rad_s[0] = 0.8 * 20.0 / 0.344;
+    BrakeMeasurements m = fl_slipping_at_full_pedal(p);
     m.wheel_rad_s[2] = 0.8 * 20.0 / 0.344;
     m.clamp_estimate_kN = {0.3, 3.0, 0.3, 3.0};
     for (int i = 0; i < 20; ++i) b.update(0.005, m);  // 0.1 s

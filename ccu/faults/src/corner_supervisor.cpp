@@ -198,10 +198,9 @@ void CornerSupervisor::refresh_view(const CornerReading* r, const SampleCheck* c
     view_.source = EstimateSource::None;
   }
   const Diagnosis& act = monitor_.diagnosis(Part::Actuator);
-  const Diagnosis& res = monitor_.diagnosis(Part::Resolver);
-  // A stuck resolver: the corner cannot commutate its motor (it drives no current) and holds
-  // whatever force it has, like an actuator that does not release.
-  const bool commutation_lost = res.active && res.finding == Finding::ResolverStuck;
+  // Without commutation the corner holds whatever force it has, like an actuator that does not
+  // release.
+  const bool commutation_lost = monitor_.commutation_lost();
   const bool actuator_usable = (!act.active || act.finding == Finding::ActuatorTorqueLoss) && !commutation_lost;
   const bool sensing = lc_ok || res_ok;
   view_.available = linked && actuator_usable && sensing;

@@ -172,11 +172,9 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   if (estimate != nullptr && estimate->valid) residual_.update(r, *estimate, p_, arbiter_, noise_, stuck_, jump_);
   const double load_kN = check.load_cell_present && arbiter_.ok(Part::LoadCell) ? r.force_kN : force_estimate_kN;
   torque_.update(c, load_kN, p_, arbiter_);
-  // A stuck resolver leaves the motor without commutation (the corner's controller drives no
-  // current, corner_unit::ControllerParams::frozen_resolver_samples): the force no longer follows
-  // the command because of the resolver, not of a second fault in the actuator.
-  const Diagnosis& resolver = arbiter_.diagnosis(Part::Resolver);
-  if (resolver.active && resolver.finding == Finding::ResolverStuck) {
+  // Without commutation the force no longer follows the command because of the resolver, not of
+  // a second fault in the actuator.
+  if (commutation_lost()) {
     tracking_.on_rejoin();
   } else {
     tracking_.update(c, force_estimate_kN, p_, arbiter_);

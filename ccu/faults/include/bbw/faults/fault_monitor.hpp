@@ -210,6 +210,12 @@ class FaultMonitor {
 
   const Diagnosis& diagnosis(Part p) const { return arbiter_.diagnosis(p); }
   bool ok(Part p) const { return arbiter_.ok(p); }
+  // A stuck resolver leaves the motor without commutation (the corner's controller drives no
+  // current, corner_unit::ControllerParams::frozen_resolver_samples): the corner holds what it has.
+  bool commutation_lost() const {
+    const Diagnosis& d = arbiter_.diagnosis(Part::Resolver);
+    return d.active && d.finding == Finding::ResolverStuck;
+  }
   // Samples arrived again after a link or process loss; cleared by take_rejoin().
   bool rejoined() const { return link_.rejoined(); }
   bool take_rejoin() { return link_.take_rejoin(); }
