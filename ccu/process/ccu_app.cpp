@@ -519,6 +519,10 @@ int CcuApp::run(std::string& error) {
         if (last_send_ != Clock::time_point{} && send_gap_s > kOwnershipDeadline_s) {
           ++failover_.stalls;
           last_stall_at_ = now;
+          if (failover_.stall_intervals.size() < runtime::CcuFailoverStats::kMaxStallIntervals) {
+            const double now_mono_s = runtime::mono_now_s();
+            failover_.stall_intervals.push_back({now_mono_s - send_gap_s, now_mono_s});
+          }
         }
         // Cut off: no block for kCutOff_s while this CCU itself ran on time (a stall of the whole
         // machine silences the corners too, and is no cut).

@@ -137,6 +137,12 @@ std::string read_file(const std::string& file) {
 std::string to_text(const CcuFailoverStats& s) {
   Writer w;
   ccu_fields(s, w);
+  w("stall_intervals", static_cast<std::uint64_t>(s.stall_intervals.size()));
+  for (std::size_t i = 0; i < s.stall_intervals.size(); ++i) {
+    const std::string p = "stall" + std::to_string(i) + ".";
+    w((p + "from_mono_s").c_str(), s.stall_intervals[i].from_mono_s);
+    w((p + "to_mono_s").c_str(), s.stall_intervals[i].to_mono_s);
+  }
   return w.str();
 }
 
@@ -163,6 +169,18 @@ CcuFailoverStats parse_ccu_failover(const std::string& text, const std::string& 
   Reader r(m, file);
   ccu_fields(s, r);
   if (s.role != "primary" && s.role != "standby") r.bad("role", s.role, "primary or standby");
+  std::uint64_t n = 0;
+  r("stall_intervals", n);
+  if (n > CcuFailoverStats::kMaxStallIntervals || n > s.stalls) {
+    r.bad("stall_intervals", std::to_string(n), "at most 64 and at most `stalls`");
+  }
+  for (std::uint64_t i = 0; i < n; ++i) {
+    const std::string p = "stall" + std::to_string(i) + ".";
+    StallInterval x;
+    r((p + "from_mono_s").c_str(), x.from_mono_s);
+    r((p + "to_mono_s").c_str(), x.to_mono_s);
+    s.stall_intervals.push_back(x);
+  }
   return s;
 }
 

@@ -312,11 +312,44 @@ TEST(SystemFailoverNetns, SplitBrainEachCornerObeysOneCcu) {
     return out;
   };
   const double settle_s = 0.05;  // FL's deadline (10 ms) and the standby's next command, with margin
+  // A corner that hears the primary still goes to the standby while the primary's commands miss
+  // the corners' 10 ms deadline (docs/faults.md "Who commands"): that is the hot standby working,
+  // not split brain. Such a visit is explained when it begins within a stall of the primary (its
+  // own sends further apart than the deadline, recorded by the primary; the corner takes it up to
+  // one command period later) or after the corner itself took nothing for a deadline (a stall of
+  // the corner), and it ends within `visit_max_s` (the primary's next command, with margin).
+  const double deadline_ms = 10.0, visit_max_s = 0.05;
+  const double period_s = loaded.scenario.ccu_period_s;
+  auto explained = [&](const bbw::runtime::OwnerSwitch& sw) {
+    if (sw.gap_ms >= deadline_ms) return true;
+    for (const auto& st : in.primary.stall_intervals) {
+      if (sw.mono_s >= st.from_mono_s + 1e-3 * deadline_ms && sw.mono_s <= st.to_mono_s + 2.0 * period_s) return true;
+    }
+    return false;
+  };
+  int stall_visits = 0;
   for (std::size_t i = 0; i < in.corners.size(); ++i) {
     const auto& s = in.corners[i].owners;
     const std::string expected = s.corner == "FL" ? "standby" : "primary";
-    EXPECT_EQ(owner_in(s, split_mono_s + settle_s, heal_mono_s), expected)
-        << s.corner << " during the split\n" << c.logs();
+    std::string trail, unexplained;
+    for (std::size_t j = 0; j < s.switches.size(); ++j) {
+      const auto& sw = s.switches[j];
+      const std::string line = "  " + sw.from + " -> " + sw.to + " at " + std::to_string(sw.mono_s - split_mono_s) +
+                               " s after the split, " + std::to_string(sw.gap_ms) + " ms after the command before\n";
+      trail += line;
+      if (sw.mono_s < split_mono_s + settle_s || sw.mono_s >= heal_mono_s || sw.to == expected) continue;
+      const bool back_soon = j + 1 < s.switches.size() && s.switches[j + 1].to == expected &&
+                             s.switches[j + 1].mono_s - sw.mono_s <= visit_max_s;
+      if (s.corner != "FL" && explained(sw) && back_soon) ++stall_visits;
+      else unexplained += line;
+    }
+    std::string stalls;
+    for (const auto& st : in.primary.stall_intervals) {
+      stalls += "  " + std::to_string(st.from_mono_s - split_mono_s) + " to " + std::to_string(st.to_mono_s - split_mono_s) + " s\n";
+    }
+    EXPECT_EQ(owner_in(s, split_mono_s + settle_s, split_mono_s + settle_s), expected) << s.corner << " as the split settled";
+    EXPECT_EQ(unexplained, "") << s.corner << " went to another CCU during the split without a stall to explain it; its switches:\n"
+                               << trail << "the primary's stalls (" << in.primary.stalls << "):\n" << stalls << c.logs();
     EXPECT_EQ(owner_in(s, heal_mono_s + 0.5, 1e12), "primary") << s.corner << " after the split healed\n" << c.logs();
     EXPECT_LT(in.corners[i].ccu_lost_s, 0.0) << s.corner << ": safe state entered";
   }
@@ -350,6 +383,7 @@ TEST(SystemFailoverNetns, SplitBrainEachCornerObeysOneCcu) {
       demand_at_worst = demand;
     }
   }
+  std::cout << "[ NOTE     ] corners that visited the standby during a stall of the primary: " << stall_visits << std::endl;
   std::cout << "[ MEASURED ] split brain (FL cut off from the primary for 1 s): FL taken over by the standby after "
             << fl_takeover_ms << " ms; total clamp force above demand by up to " << worst_excess_kN << " kN (demand "
             << demand_at_worst << " kN)" << std::endl;

@@ -58,11 +58,23 @@ TEST(FailoverStats, RoundTripAndNameWhatIsWrong) {
   c.failed_mono_s = 1234.5;
   c.outages = 1;
   c.demote_reason = "resumed after a stop";
+  c.stalls = 3;  // the first two recorded
+  c.stall_intervals = {{100.25, 100.5}, {200.0, 200.0125}};
   const auto back = runtime::parse_ccu_failover(runtime::to_text(c), "x.stats");
   EXPECT_EQ(back.role, "primary");
   EXPECT_EQ(back.strength_final, c.strength_final);
   EXPECT_EQ(back.demote_reason, "resumed after a stop");
   EXPECT_DOUBLE_EQ(back.failed_sim_s, 3.5);
+  ASSERT_EQ(back.stall_intervals.size(), 2u);
+  EXPECT_DOUBLE_EQ(back.stall_intervals[1].to_mono_s, 200.0125);
+  std::string more = runtime::to_text(c);
+  more.replace(more.find("stalls=3"), 8, "stalls=1");  // more intervals than stalls
+  try {
+    runtime::parse_ccu_failover(more, "w.stats");
+    FAIL() << "more stall intervals than stalls must be an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("w.stats: key 'stall_intervals'"), std::string::npos) << e.what();
+  }
   runtime::CornerFailoverStats k;
   k.corner = "FL";
   k.switches.push_back({"none", "primary", 0, 0.0, 10.0, 0.0});

@@ -17,7 +17,14 @@ namespace bbw::runtime {
 // steady_clock now, in seconds since its epoch (CLOCK_MONOTONIC).
 double mono_now_s();
 
+// One of a CCU's own stalls: two consecutive sends further apart than the command deadline.
+struct StallInterval {
+  double from_mono_s = 0.0;  // the send before the stall
+  double to_mono_s = 0.0;    // when the CCU ran again (its next send follows at once)
+};
+
 struct CcuFailoverStats {
+  static constexpr std::size_t kMaxStallIntervals = 64;  // the first ones are kept; `stalls` counts all
   std::string role;                  // primary | standby
   std::uint32_t strength_initial = 0;
   std::uint32_t strength_final = 0;
@@ -27,6 +34,7 @@ struct CcuFailoverStats {
   double resumed_mono_s = -1.0;      // continued after the hang (-1: never)
   std::uint32_t outages = 0;         // times it lowered its strength (stopped and continued, or cut off)
   std::uint32_t stalls = 0;          // realtime: its own commands further apart than the command deadline
+  std::vector<StallInterval> stall_intervals;  // the first kMaxStallIntervals of them, in order
   double demoted_sim_s = -1.0;       // the last time it did (-1: never)
   double demoted_mono_s = -1.0;
   std::string demote_reason;         // the last reason: "" | resumed after a stop | cut off from every corner
