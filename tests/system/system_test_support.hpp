@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "bbw/runtime/child.hpp"
 
 namespace bbw::system_test {
@@ -28,12 +30,39 @@ inline std::string slurp(const std::string& file) {
   return ss.str();
 }
 
-// A fresh, empty folder /tmp/bbw_<prefix>_<test>_<pid>.
+// A test's scratch folders are removed when it passes and kept when it fails (for the post-mortem;
+// a failure message names the folder). Without this every run left 10 MB per system test in /tmp.
+class RemoveScratchOnPass : public ::testing::EmptyTestEventListener {
+ public:
+  static void add(const std::string& dir) {
+    static RemoveScratchOnPass* listener = [] {
+      auto* l = new RemoveScratchOnPass;
+      ::testing::UnitTest::GetInstance()->listeners().Append(l);  // owned by gtest from here
+      return l;
+    }();
+    listener->dirs_.push_back(dir);
+  }
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    if (info.result() != nullptr && info.result()->Passed()) {
+      for (const auto& d : dirs_) {
+        std::error_code ec;
+        std::filesystem::remove_all(d, ec);
+      }
+    }
+    dirs_.clear();
+  }
+
+ private:
+  std::vector<std::string> dirs_;
+};
+
+// A fresh, empty folder /tmp/bbw_<prefix>_<test>_<pid>, removed when the test passes.
 inline std::string scratch(const std::string& prefix, const std::string& test) {
   namespace fs = std::filesystem;
   const fs::path p = fs::temp_directory_path() / ("bbw_" + prefix + "_" + test + "_" + std::to_string(::getpid()));
   fs::remove_all(p);
   fs::create_directories(p);
+  RemoveScratchOnPass::add(p.string());
   return p.string();
 }
 

@@ -58,6 +58,7 @@ class Cluster {
     dir_ = (fs::temp_directory_path() / ("bbw_failover_netns_" + test + "_" + std::to_string(::getpid()))).string();
     fs::remove_all(dir_);
     fs::create_directories(dir_ + "/out/standby");
+    bbw::system_test::RemoveScratchOnPass::add(dir_);
     guard_ = std::make_unique<Namespaces>(dir_);
   }
   ~Cluster() {

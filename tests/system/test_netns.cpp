@@ -108,6 +108,7 @@ TEST(SystemNetns, CornerLinkDownIsDetectedAndTheCornerRejoins) {
   fs::remove_all(dir);
   fs::create_directories(dir / "out");
   const std::string d = dir.string();
+  bbw::system_test::RemoveScratchOnPass::add(d);
   Namespaces::remove_orphans(d);
 
   // Namespaces: bridge, CCU, one per corner. Roles 0 = CCU, 1.. = corners.
