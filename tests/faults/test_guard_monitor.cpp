@@ -582,6 +582,60 @@ TEST(FaultMonitor, AnUnexplainedTorqueNearStandstillIsALostActuatorAtAnyLoad) {
   EXPECT_EQ(seized_release.diagnosis(Part::Actuator).finding, Finding::ActuatorLost);
 }
 
+// A drive that seizes in a held stop (issue 14, tune_b run 376): the healthy hold sits at about
+// 0 A; seized, the loop's integrators wind the current up (about 20 A/s) against a rotor that
+// does not turn, while the force stays at its command. That is a lost actuator within the seized
+// window (0.5 s), not a torque loss: before the winding-up rule the torque-loss fraction named it
+// a torque loss after 0.3 s and the lost fraction only after 0.6 s. The same ramp while the force
+// is 2 kN below its command (a drive breaking away towards a higher command), the healthy hold,
+// and a steady 2x holding current (a 50 % torque loss: a torque loss) are not.
+TEST(FaultMonitor, ASeizedDriveInAHoldWindsItsCurrentUpAndIsLostNotATorqueLoss) {
+  MonitorParams p = noiseless();
+  p.eol_curve = bbw::plant::ClampCurveParams{};
+  p.eol_friction_half_width_kN = 1.0;
+  const bbw::plant::ClampCurve eol{*p.eol_curve};
+  const double T = p.eol_curve->reference_temperature_C;
+  double lo = 0.5, hi = 10.0;  // the position of 21.5 kN on the end-of-line curve
+  for (int i = 0; i < 60; ++i) ((eol.force_kN(0.5 * (lo + hi), T, 0.0) < 21.5) ? lo : hi) = 0.5 * (lo + hi);
+  const double x = 0.5 * (lo + hi);
+  SampleCheck ok;
+  struct Seen {
+    Diagnosis actuator;
+    bool torque_loss = false;
+  };
+  // From 0.3 s on, the current follows current_A(time since); before, before_A (the healthy hold's 0 A).
+  auto run = [&](double command_kN, auto current_A, double until_s, double before_A = 0.0) {
+    FaultMonitor m(p, Target::RR);
+    Seen seen;
+    for (int k = 1; 0.001 * k <= until_s + 1e-12; ++k) {
+      auto r = at(k, 0.001 * k, x + 2e-5 * ((k * 7) % 3), 21.5 + 0.03 * ((k % 5) - 2));
+      r.temperature_C = T;
+      r.speed_rev_per_s = 0.004 * ((k % 3) - 1);
+      r.force_command_kN = command_kN;
+      r.motor_current_A = r.time_s < 0.3 ? before_A : current_A(r.time_s - 0.3);
+      m.update(r, ok, nullptr, r.force_kN, r.time_s);
+      if (m.diagnosis(Part::Actuator).present && m.diagnosis(Part::Actuator).finding == Finding::ActuatorTorqueLoss) {
+        seen.torque_loss = true;
+      }
+    }
+    seen.actuator = m.diagnosis(Part::Actuator);
+    return seen;
+  };
+  auto ramp = [](double t) { return 20.0 * t; };
+  const Seen seized = run(21.5, ramp, 1.0);
+  ASSERT_TRUE(seized.actuator.present);
+  EXPECT_EQ(seized.actuator.finding, Finding::ActuatorLost);
+  EXPECT_LT(seized.actuator.finding_s, 0.3 + 0.5) << "named lost " << seized.actuator.finding_s - 0.3 << " s into the ramp";
+  EXPECT_FALSE(seized.torque_loss);
+  // 0.5 s of the ramp, 2 kN below the command: the older rules' torque loss, no lost actuator.
+  const Seen breaking_away = run(19.5, ramp, 0.8);
+  EXPECT_NE(breaking_away.actuator.finding, Finding::ActuatorLost);
+  EXPECT_FALSE(run(21.5, [](double) { return 0.0; }, 2.0).actuator.present);
+  const double twice_hold_A = 2.0 * 21.5 * p.Nm_per_kN / p.torque_per_A_Nm;
+  const Seen half_torque = run(21.5, [&](double) { return twice_hold_A; }, 2.0, twice_hold_A);
+  EXPECT_EQ(half_torque.actuator.finding, Finding::ActuatorTorqueLoss);
+}
+
 // A load-cell step while the actuator stands still (issue 14): the force cannot change, so a
 // reading that leaves the still window's level and stays is a load-cell offset, at any force and
 // without a fit (a 1 kN bias at 30 kN, where the end-of-line band is 2.4 kN wide). A noise spike

@@ -93,6 +93,10 @@ void MonitorParams::validate() const {
           unexplained_relative, "must be >= 0");
   positive("unexplained_max_speed_rev_per_s", unexplained_max_speed_rev_per_s);
   positive("unexplained_persist_s", unexplained_persist_s);
+  positive("seized_static_rev", seized_static_rev);
+  positive("seized_window_s", seized_window_s);
+  positive("seized_ramp_Nm", seized_ramp_Nm);
+  positive("seized_force_error_kN", seized_force_error_kN);
   positive("torque_check_min_load_kN", torque_check_min_load_kN);
   positive("torque_check_max_speed_rev_per_s", torque_check_max_speed_rev_per_s);
   positive("torque_persist_s", torque_persist_s);

@@ -104,6 +104,10 @@ MonitorParams read_monitor_params(Reader& r) {
   p.unexplained_relative = t.number("unexplained_relative", Range::closed(0.0, 10.0));
   p.unexplained_max_speed_rev_per_s = t.number("unexplained_max_speed_rev_per_s", pos);
   p.unexplained_persist_s = t.number("unexplained_persist_s", pos);
+  p.seized_static_rev = t.number("seized_static_rev", pos);
+  p.seized_window_s = t.number("seized_window_s", pos);
+  p.seized_ramp_Nm = t.number("seized_ramp_Nm", pos);
+  p.seized_force_error_kN = t.number("seized_force_error_kN", pos);
   t.finish();
 
   auto k = r.map("tracking");

@@ -18,7 +18,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, const Monito
   const bool repeated = c.have_prev && r.speed_rev_per_s != 0.0 && r.speed_rev_per_s == c.prev.speed_rev_per_s;
   speed_repeats_ = repeated ? speed_repeats_ + 1 : 0;
   if (!a.ok(Part::Resolver) || !std::isfinite(load_kN) || speed_repeats_ >= p.frozen_attribution_samples) {
-    torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = false;
+    torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = static_init_ = false;
     return;
   }
   constexpr double kTwoPi = 6.283185307179586;
@@ -75,10 +75,27 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, const Monito
   const double band = p.drive_friction_Nm + p.unexplained_margin_Nm + p.unexplained_relative * load_Nm;
   excess_Nm_ = make_Nm_ - need_hi_Nm_;
   const bool slow = std::abs(r.speed_rev_per_s) <= p.unexplained_max_speed_rev_per_s;
+  // Seized in a hold: stopped where it is, the force where it is commanded, and still the made
+  // torque rises (MonitorParams::seized_*).
+  const bool stopped = slow && static_init_ && std::abs(r.position_rev - static_position_rev_) <= p.seized_static_rev;
+  if (!stopped) {
+    static_init_ = true;
+    static_position_rev_ = r.position_rev;
+    static_since_s_ = t;
+    static_min_make_Nm_ = make_Nm_;
+  } else {
+    static_min_make_Nm_ = std::min(static_min_make_Nm_, make_Nm_);
+  }
+  const bool on_command = std::isfinite(r.force_command_kN) && std::abs(r.force_command_kN - load_kN) <= p.seized_force_error_kN;
+  // The loop winds up against a rotor that does not turn. (Not down: a healthy hold's current
+  // may fall to about 0 A while the drive's and the keys' friction hold the load; tried on the
+  // tuning seed, 3 fault-free false alarms in hard stops.)
+  const bool winding_up = stopped && on_command && t - static_since_s_ >= p.seized_window_s &&
+                          make_Nm_ - static_min_make_Nm_ >= p.seized_ramp_Nm;
   // Pushing: beyond the band and less than the lost threshold of it needed (a partial torque
-  // loss the loop absorbs is not a lost actuator).
+  // loss the loop absorbs is not a lost actuator), or winding up against a seized drive.
   const bool pushing = make_Nm_ - need_hi_Nm_ > band &&
-                       need_hi_Nm_ + p.drive_friction_Nm < p.torque_lost_threshold * make_Nm_;
+                       (need_hi_Nm_ + p.drive_friction_Nm < p.torque_lost_threshold * make_Nm_ || winding_up);
   // Pulling: beyond the band plus the whole load (a gear in its backlash gap carries none of it).
   const bool pulling = need_lo_Nm_ - make_Nm_ > band + load_Nm;
   if (slow && (pushing || pulling)) {
@@ -91,7 +108,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, const Monito
     unexplained_suspect_ = false;
   }
   const bool still = std::abs(r.speed_rev_per_s) <= p.torque_check_max_speed_rev_per_s;
-  if (checkable && still && fraction < p.torque_fraction_threshold) {
+  if (checkable && still && fraction < p.torque_fraction_threshold && !winding_up) {
     if (!torque_suspect_) {
       torque_suspect_ = true;
       torque_onset_s_ = t;

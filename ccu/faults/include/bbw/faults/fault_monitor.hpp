@@ -178,6 +178,16 @@ struct MonitorParams {
   double unexplained_relative = 0.3;
   double unexplained_max_speed_rev_per_s = 2.0;
   double unexplained_persist_s = 0.03;
+  // A seized drive in a hold: the position stays within seized_static_rev of where it stopped for
+  // at least seized_window_s, the force stays within seized_force_error_kN of its command, and the
+  // made torque has risen by seized_ramp_Nm since the drive stopped (the loop's integrators wind
+  // up against a rotor that does not turn; a healthy or weakened drive turns, or needs no more
+  // current while the force is where it is commanded). Such a ramp counts as a lost actuator once
+  // the torque is unexplained (beyond the band above), and it is not named a torque loss.
+  double seized_static_rev = 1.0e-4;
+  double seized_window_s = 0.1;
+  double seized_ramp_Nm = 0.3;
+  double seized_force_error_kN = 0.5;
   // Tracking backstop: the force against a first-order model of the commanded response. A
   // shortfall below both is ActuatorTracking; an excess above both (a brake that does not
   // release) is ActuatorNotReleasing, with the same threshold and persistence.

@@ -25,7 +25,7 @@ class TorqueDetector {
   // `load_kN`: the load cell while it is trusted, else the CCU's force estimate.
   void update(const SampleContext& c, double load_kN, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() {
-    torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = false;
+    torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = static_init_ = false;
     speed_repeats_ = 0;
   }
   double fraction() const { return fraction_; }
@@ -49,6 +49,11 @@ class TorqueDetector {
   double unexplained_onset_s_ = 0.0;
   double excess_Nm_ = 0.0;
   int speed_repeats_ = 0;  // samples whose speed equals the previous one exactly
+  // The seized-in-a-hold rule: where and when the drive stopped, the least made torque since.
+  bool static_init_ = false;
+  double static_position_rev_ = 0.0;
+  double static_since_s_ = 0.0;
+  double static_min_make_Nm_ = 0.0;
 };
 
 }  // namespace bbw::faults
