@@ -86,6 +86,43 @@ TEST(CampaignSystem, CiSubsetOverDdsIsNoWorseThanMeasured) {
 
 // A campaign killed mid-way (a run without its result, a half-written result, a run's leftover
 // logs) resumes: the same command runs only what is missing and leaves finished results alone.
+// A spec that draws members the population does not have is refused at the plan, naming the file,
+// line, key and the population's count (before: every run drawing such a member ended without a
+// result, 289 of tune_c's 600 when it first asked for 60 members of a 30-member population).
+TEST(CampaignSystem, MembersBeyondThePopulationAreRefusedAtThePlan) {
+  const std::string dir = bbw::system_test::scratch("campaign", "members");
+  const std::string spec = small_spec(dir, 3);
+  std::string text = slurp(spec);
+  text.replace(text.find("members: 30"), 11, "members: 31");
+  std::ofstream(spec) << text;
+  const auto r = bbw::system_test::run("plan", {bin("bbw_campaign"), "plan", spec, "--out", dir + "/c"}, dir, 60s);
+  EXPECT_FALSE(r.status.ok());
+  EXPECT_NE(r.err.find(spec + ":6: key 'population.members': must be at most the population's count (30 in "),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/c/runs/00000/scenario.yaml"));
+}
+
+// A fault-free campaign (tune_c.yaml hunts false alarms so) reports its false-alarm rate and no
+// coverage: not "0/0 (0.00 %)", and no empty plots (gnuplot refused their empty range and the
+// campaign said "plots not written").
+TEST(CampaignSystem, AFaultFreeCampaignReportsItsFalseAlarmRateAndNoCoverage) {
+  const std::string dir = bbw::system_test::scratch("campaign", "fault_free");
+  const std::string spec = small_spec(dir, 2);
+  std::string text = slurp(spec);
+  text.replace(text.find("fault_free_share: 0.34"), 22, "fault_free_share: 1.0");
+  std::ofstream(spec) << text;
+  const auto r = campaign(dir, "ff", {spec, "--out", dir + "/c", "--jobs", "2", "--transport", "memory"}, 120s);
+  ASSERT_TRUE(r.status.ok()) << r.status.describe() << r.err;
+  EXPECT_NE(r.out.find("small: no fault injected, false alarms 0 in 0.01 h fault-free"), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find("plots not written"), std::string::npos) << r.err;
+  const YAML::Node c = YAML::LoadFile(dir + "/c/campaign.json");
+  EXPECT_EQ(c["overall"]["faults"].as<int>(), 0);
+  EXPECT_EQ(c["false_alarms"]["fault_free_runs"].as<int>(), 2);
+  EXPECT_GT(c["false_alarms"]["per_hour_upper95"].as<double>(), 0.0);  // 0 seen is not a 0 rate
+  EXPECT_NE(slurp(dir + "/c/report.html").find("No fault was injected"), std::string::npos);
+}
+
 TEST(CampaignSystem, AKilledCampaignResumesAndRunsOnlyWhatIsMissing) {
   const std::string dir = bbw::system_test::scratch("campaign", "resume");
   const std::string spec = small_spec(dir, 6);

@@ -34,6 +34,7 @@
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/runtime/child.hpp"
 #include "bbw/runtime/run_stats.hpp"
+#include "bbw/scenario/population.hpp"
 #include "draw.hpp"
 #include "metrics.hpp"
 #include "run_result.hpp"
@@ -87,6 +88,14 @@ double epoch_s() {
 
 int cmd_plan(const std::string& spec_file, const std::string& dir) {
   const CampaignSpec spec = load_campaign_spec(spec_file);
+  // Every member drawn must exist: a run's scenario names its member, and the scenario loader
+  // refuses one beyond the population's count (found as 289 runs without a result, not at the plan).
+  const int count = scenario::load_population_spec(spec.population_spec).count;
+  if (spec.population_members > count) {
+    throw config::ConfigError(spec.file, spec.population_line, "population.members",
+                              "must be at most the population's count (" + std::to_string(count) + " in " +
+                                  spec.population_spec + "), got " + std::to_string(spec.population_members));
+  }
   const std::string text = slurp(spec_file);
   fs::create_directories(dir + "/runs");
   const std::string kept = dir + "/spec.yaml";
@@ -409,9 +418,10 @@ int cmd_report(const std::string& dir) {
      << "set title 'Harm while undetected (each injected fault; log scales, floored at 0.01 kN)'\nset xlabel 'max |true force - command|, kN'\nset ylabel 'max |estimate - true force|, kN'\n"
      << "set logscale xy\n"
      << "plot " << plot::quote(pd + "/harm.dat") << " using ($3==1?($1>0.01?$1:0.01):1/0):($2>0.01?$2:0.01) with points pt 7 ps 0.6 title 'detected', '' using ($3==0?($1>0.01?$1:0.01):1/0):($2>0.01?$2:0.01) with points pt 2 ps 1.2 lc rgb 'red' title 'missed'\n";
-  bool plots = true;
+  // A fault-free campaign has no coverage, latency or harm to plot (gnuplot refuses an empty range).
+  bool plots = all.n > 0;
   try {
-    plot::run_gnuplot(gp.str(), pd + "/campaign.gp");
+    if (plots) plot::run_gnuplot(gp.str(), pd + "/campaign.gp");
   } catch (const std::exception& e) {
     plots = false;
     std::cerr << "bbw_campaign: plots not written: " << e.what() << "\n";
@@ -446,10 +456,13 @@ int cmd_report(const std::string& dir) {
   for (const auto& m : all.misses) h << "<li>" << m << "</li>";
   h << "</ul>";
   if (plots) h << "<h2>Plots</h2><img src='plots/coverage.png'><br><img src='plots/latency.png'><br><img src='plots/harm.png'>";
+  if (all.n == 0) h << "<p>No fault was injected: no coverage, latency or harm to plot.</p>";
   h << "</body></html>\n";
   write_file(dir + "/report.html", h.str());
-  std::cout << "bbw_campaign: " << spec.name << ": coverage " << all.detected << "/" << all.n << " ("
-            << fmt(all.n ? 100.0 * all.detected / all.n : 0.0, 2) << " %), false alarms " << ff_alarms << " in " << fmt(ff_hours, 2)
+  std::cout << "bbw_campaign: " << spec.name << ": "
+            << (all.n ? "coverage " + std::to_string(all.detected) + "/" + std::to_string(all.n) + " (" + fmt(100.0 * all.detected / all.n, 2) + " %)"
+                      : std::string("no fault injected"))
+            << ", false alarms " << ff_alarms << " in " << fmt(ff_hours, 2)
             << " h fault-free (+" << faulty_run_alarms << " in faulty runs), " << failed << " failed runs; " << dir
             << "/campaign.json, " << dir << "/report.html\n";
   if (missing > 0) {

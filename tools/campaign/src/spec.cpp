@@ -58,6 +58,7 @@ CampaignSpec read(config::Reader& r) {
     config::Reader p = r.map("population");
     s.population_spec = std::filesystem::absolute(config::resolve_relative(r.file(), p.string("spec"))).lexically_normal().string();
     s.population_members = static_cast<int>(p.integer("members", 1, 100000));
+    s.population_line = p.line();
     p.finish();
   }
   std::tie(s.temperature_min_C, s.temperature_max_C) = interval(r, "temperatures_C", config::Range::closed(-40.0, 140.0));

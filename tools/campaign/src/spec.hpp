@@ -33,6 +33,8 @@ struct CampaignSpec {
   double duration_min_s = 16.0, duration_max_s = 24.0;
   std::string population_spec;           // absolute path of a population spec (config/population/)
   int population_members = 1;            // members 0 .. n-1 are drawn
+  int population_line = 0;               // where `population` is in `file` (bbw_campaign checks the
+                                         // members against the population's count there)
   double temperature_min_C = 28.0, temperature_max_C = 54.0;
   double effects_share = 0.3;            // of the corners: one plant effect switched on
   std::vector<Profile> profiles;
