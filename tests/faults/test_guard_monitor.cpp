@@ -283,6 +283,46 @@ TEST(FaultMonitor, AChannelFrozenInAHoldIsStuck) {
   EXPECT_TRUE(coarse.ok(Part::LoadCell)) << to_string(coarse.diagnosis(Part::LoadCell).finding);
 }
 
+// Once the resolver is diagnosed there is no residual (it needs the position), so the noise
+// rule had nothing to count and a noise burst after a stuck resolver went unseen (issue 14: 4 of
+// tune_b's 5 noise-burst misses). The load cell's own second difference takes over: a 0.25 kN
+// RMS burst (the stated limit) on a force that moves like a 10 Hz ABS modulation is found within
+// 0.1 s; the same load cell at 0.05 kN RMS for 20 s is not.
+TEST(FaultMonitor, ANoisyLoadCellIsFoundAfterTheResolverIsDiagnosed) {
+  auto run = [](double burst_rms_kN, double until_s) {
+    MonitorParams p;
+    SampleCheck ok;
+    FaultMonitor m(p, Target::RL);
+    std::mt19937_64 rng(11);
+    std::normal_distribution<double> n01(0.0, 1.0);
+    CornerReading held{};
+    for (int k = 1; 0.001 * k <= until_s + 1e-12; ++k) {
+      const double t = 0.001 * k;
+      const double w = 2.0 * 3.14159265358979 * 10.0;
+      const double force_kN = 15.0 + 5.0 * std::sin(w * t);  // 20 kN/rev: the position moves with it
+      const double rms_kN = t >= 1.0 ? burst_rms_kN : 0.05;
+      auto r = at(k, t, std::round((4.0 + 0.05 * (force_kN - 15.0) + 2e-5 * n01(rng)) / 2e-5) * 2e-5,
+                  force_kN + rms_kN * n01(rng));
+      r.speed_rev_per_s = 0.25 * w * std::cos(w * t) + 0.005 * n01(rng);
+      r.motor_current_A = 0.0;
+      if (k == 500) held = r;
+      if (k >= 500) {  // the resolver sticks at 0.5 s
+        r.position_rev = held.position_rev;
+        r.speed_rev_per_s = held.speed_rev_per_s;
+      }
+      m.update(r, ok, nullptr, r.force_kN, t);
+    }
+    return m;
+  };
+  const auto burst = run(0.25, 1.5);
+  ASSERT_EQ(burst.diagnosis(Part::Resolver).finding, Finding::ResolverStuck);
+  EXPECT_EQ(burst.diagnosis(Part::LoadCell).finding, Finding::LoadCellNoisy) << to_string(burst.diagnosis(Part::LoadCell).finding) << " at " << burst.diagnosis(Part::LoadCell).detected_s;
+  EXPECT_LT(burst.diagnosis(Part::LoadCell).detected_s, 1.1);
+  const auto healthy = run(0.05, 20.0);
+  EXPECT_EQ(healthy.diagnosis(Part::Resolver).finding, Finding::ResolverStuck);
+  EXPECT_TRUE(healthy.ok(Part::LoadCell)) << to_string(healthy.diagnosis(Part::LoadCell).finding) << " at " << healthy.diagnosis(Part::LoadCell).detected_s;
+}
+
 TEST(FaultMonitor, DropoutNeedsConsecutiveMissingValues) {
   MonitorParams p;
   FaultMonitor m(p, Target::FL);

@@ -72,6 +72,7 @@ void MonitorParams::validate() const {
   require(noise_window_samples >= 4 && noise_window_samples <= kMaxNoiseWindow, "noise_window_samples",
           noise_window_samples, "must be in [4, 256]");
   positive("noise_step_kN", noise_step_kN);
+  positive("noise_second_difference_kN", noise_second_difference_kN);
   require(noise_min_fraction > 0.0 && noise_min_fraction <= 1.0, "noise_min_fraction", noise_min_fraction,
           "must be in (0, 1]");
   require(dropout_samples >= 1, "dropout_samples", dropout_samples, "must be >= 1");
@@ -173,7 +174,13 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   jump_.update(c, p_, arbiter_);
   stuck_.update(c, p_, arbiter_);
   step_.update(c, p_, arbiter_);
-  if (estimate != nullptr && estimate->valid) residual_.update(r, *estimate, p_, arbiter_, noise_, stuck_, jump_);
+  if (estimate != nullptr && estimate->valid) {
+    residual_.update(r, *estimate, p_, arbiter_, noise_, stuck_, jump_);
+  } else if (!arbiter_.ok(Part::Resolver) && arbiter_.ok(Part::LoadCell) && have_prev_ && check.load_cell_present &&
+             prev_lc_present_ && std::isfinite(r.force_kN) && std::isfinite(prev_.force_kN)) {
+    // No residual without the position: a noisy load cell is still found by its own differences.
+    noise_.update_load_cell_difference(r.force_kN - prev_.force_kN, r.time_s, p_, arbiter_);
+  }
   const double load_kN = check.load_cell_present && arbiter_.ok(Part::LoadCell) ? r.force_kN : force_estimate_kN;
   torque_.update(c, load_kN, p_, arbiter_);
   // Without commutation the force no longer follows the command because of the resolver, not of

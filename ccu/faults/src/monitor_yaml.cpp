@@ -84,6 +84,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.noise_window_samples = static_cast<int>(n.integer("window_samples", 4, kMaxNoiseWindow));
   p.noise_step_kN = n.number("step_kN", pos);
   p.noise_min_fraction = n.number("min_fraction", Range{0.0, 1.0, true, false});
+  p.noise_second_difference_kN = n.number("second_difference_kN", pos);
   n.finish();
 
   auto d = r.map("dropout");

@@ -7,6 +7,7 @@
 namespace bbw::faults {
 
 void NoiseDetector::update(double residual_kN, double model_kN, double t, const MonitorParams& p, DiagnosisArbiter& a) {
+  have_prev_difference_ = false;  // the difference path starts afresh when it is next used
   if (!have_prev_residual_) {
     have_prev_residual_ = true;
     prev_residual_kN_ = residual_kN;
@@ -17,10 +18,26 @@ void NoiseDetector::update(double residual_kN, double model_kN, double t, const 
   const double model_step_kN = std::isfinite(model_kN - prev_model_kN_) ? std::abs(model_kN - prev_model_kN_) : 0.0;
   prev_residual_kN_ = residual_kN;
   prev_model_kN_ = model_kN;
+  count(std::abs(d) > p.noise_step_kN + model_step_kN, t, p, a);
+}
+
+void NoiseDetector::update_load_cell_difference(double difference_kN, double t, const MonitorParams& p,
+                                                DiagnosisArbiter& a) {
+  if (!have_prev_difference_) {
+    have_prev_difference_ = true;
+    prev_difference_kN_ = difference_kN;
+    return;
+  }
+  const double second_kN = difference_kN - prev_difference_kN_;
+  prev_difference_kN_ = difference_kN;
+  count(std::abs(second_kN) > p.noise_second_difference_kN, t, p, a);
+}
+
+void NoiseDetector::count(bool big, double t, const MonitorParams& p, DiagnosisArbiter& a) {
   const int w = p.noise_window_samples;
   const auto h = static_cast<std::size_t>(head_);
   if (count_ == w) big_count_ -= big_[h];
-  big_[h] = std::abs(d) > p.noise_step_kN + model_step_kN ? 1 : 0;
+  big_[h] = big ? 1 : 0;
   big_count_ += big_[h];
   head_ = (head_ + 1) % w;
   if (count_ < w) ++count_;

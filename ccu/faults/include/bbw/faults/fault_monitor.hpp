@@ -146,6 +146,12 @@ struct MonitorParams {
   int noise_window_samples = 32;              // <= kMaxNoiseWindow
   double noise_step_kN = 0.25;                // about 6x the healthy change (0.03 kN RMS load cell)
   double noise_min_fraction = 0.25;
+  // Once the resolver is diagnosed there is no residual (it needs the position): the load cell's
+  // own second difference F[k] - 2F[k-1] + F[k-2] then counts as big beyond this (N(0, 2.45 x
+  // the load cell's RMS): 0.4 % of a healthy 0.05 kN load cell's beyond 0.35 kN, 57 % of a
+  // 0.25 kN RMS burst's; the clamp force's own second difference is below 0.03 kN per sample
+  // even in 10 Hz ABS modulation).
+  double noise_second_difference_kN = 0.35;
 
   // Dropout: consecutive samples without a load-cell value.
   int dropout_samples = 5;

@@ -19,13 +19,19 @@ inline constexpr int kMaxNoiseWindow = 256;
 class NoiseDetector {
  public:
   void update(double residual_kN, double model_kN, double t, const MonitorParams& p, DiagnosisArbiter& a);
-  void on_rejoin() { have_prev_residual_ = false; }
+  // Without a residual (the resolver is diagnosed): the load cell's first difference F[k] - F[k-1];
+  // its change, the second difference, counts as big beyond noise_second_difference_kN.
+  void update_load_cell_difference(double difference_kN, double t, const MonitorParams& p, DiagnosisArbiter& a);
+  void on_rejoin() { have_prev_residual_ = have_prev_difference_ = false; }
   double fraction() const { return fraction_; }
 
  private:
   bool have_prev_residual_ = false;
   double prev_residual_kN_ = 0.0;
   double prev_model_kN_ = 0.0;
+  bool have_prev_difference_ = false;
+  double prev_difference_kN_ = 0.0;
+  void count(bool big, double t, const MonitorParams& p, DiagnosisArbiter& a);
   std::array<std::uint8_t, kMaxNoiseWindow> big_{};
   int count_ = 0;
   int head_ = 0;
