@@ -84,8 +84,6 @@ TEST(CampaignSystem, CiSubsetOverDdsIsNoWorseThanMeasured) {
   if (!HasFailure()) fs::remove_all(dir);
 }
 
-// A campaign killed mid-way (a run without its result, a half-written result, a run's leftover
-// logs) resumes: the same command runs only what is missing and leaves finished results alone.
 // A spec that draws members the population does not have is refused at the plan, naming the file,
 // line, key and the population's count (before: every run drawing such a member ended without a
 // result, 289 of tune_c's 600 when it first asked for 60 members of a 30-member population).
@@ -123,6 +121,8 @@ TEST(CampaignSystem, AFaultFreeCampaignReportsItsFalseAlarmRateAndNoCoverage) {
   EXPECT_NE(slurp(dir + "/c/report.html").find("No fault was injected"), std::string::npos);
 }
 
+// A campaign killed mid-way (a run without its result, a half-written result, a run's leftover
+// logs) resumes: the same command runs only what is missing and leaves finished results alone.
 TEST(CampaignSystem, AKilledCampaignResumesAndRunsOnlyWhatIsMissing) {
   const std::string dir = bbw::system_test::scratch("campaign", "resume");
   const std::string spec = small_spec(dir, 6);
