@@ -68,20 +68,23 @@ void CornerSupervisor::rejoin() {
   // calibrator restarts from the last good curve and friction stiffnesses (its cycle state
   // does not survive the gap).
   guard_.rejoin();
-  const CalibrationSnapshot& good = last_good_.newest();
-  calibration::CalibratorConfig cfg = config_;
-  cfg.initial_curve = good.curve;
-  calibrator_.emplace(cfg);
-  calibrator_->set_friction_stiffness(good.stiffness_kN_per_rev);
-  fusion_.reset();
-  last_fed_time_s_ = std::numeric_limits<double>::quiet_NaN();
-  ++restarts_;
+  restart_calibrator();
 }
 
 void CornerSupervisor::resume_after_dropout() {
   // The load cell is back: the calibrator it stopped resumes from the newest good curve (its
   // cycle state did not survive the gap), and the load cell is used again.
   load_cell_reacted_ = false;
+  restart_calibrator();
+}
+
+void CornerSupervisor::resume_after_resolver() {
+  // The resolver lives again after it was stuck: likewise, and the position is used again.
+  resolver_reacted_ = false;
+  restart_calibrator();
+}
+
+void CornerSupervisor::restart_calibrator() {
   const CalibrationSnapshot& good = last_good_.newest();
   calibration::CalibratorConfig cfg = config_;
   cfg.initial_curve = good.curve;
@@ -145,6 +148,7 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
   monitor_.update(r, check, fed, monitored_kN, arrival_s);
   if (monitor_.take_rejoin()) rejoin();
   if (monitor_.take_load_cell_cleared()) resume_after_dropout();
+  if (monitor_.take_resolver_cleared()) resume_after_resolver();
   react_to_new_findings();
   if (fed != nullptr && e.valid) {
     if (e.fit_accepted && monitor_.ok(Part::LoadCell) && monitor_.ok(Part::Resolver)) {

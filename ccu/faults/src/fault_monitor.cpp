@@ -54,6 +54,7 @@ void MonitorParams::validate() const {
   positive("jump_window_s", jump_window_s);
   positive("jump_max_gap_s", jump_max_gap_s);
   require(stuck_samples >= 2, "stuck_samples", stuck_samples, "must be >= 2");
+  require(stuck_resolver_clear_samples >= 2, "stuck_resolver_clear_samples", stuck_resolver_clear_samples, "must be >= 2");
   positive("stuck_min_travel_rev", stuck_min_travel_rev);
   positive("stuck_min_force_change_kN", stuck_min_force_change_kN);
   require(step_still_samples >= 2 && step_still_samples <= StepDetector::kMaxWindow, "step_still_samples",

@@ -69,6 +69,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.frozen_attribution_samples = static_cast<int>(s.integer("frozen_attribution_samples", 2, 100000));
   p.stuck_frozen_samples = static_cast<int>(s.integer("frozen_samples", 2, 100000));
   p.stuck_frozen_run_factor = s.number("frozen_run_factor", config::Range::closed(0.0, 1000.0));
+  p.stuck_resolver_clear_samples = static_cast<int>(s.integer("resolver_clear_samples", 2, 100000));
   s.finish();
 
   auto st = r.map("step");

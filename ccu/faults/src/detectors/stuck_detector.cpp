@@ -46,6 +46,18 @@ void StuckDetector::update(const SampleContext& c, const MonitorParams& p, Diagn
     longest_resolver_run_ = std::max(longest_resolver_run_, resolver_frozen_);
     resolver_frozen_ = 0;
   }
+  // A resolver diagnosed stuck that lives again (its unquantised speed changes every sample).
+  const Diagnosis& rd = a.diagnosis(Part::Resolver);
+  if (rd.active && rd.finding == Finding::ResolverStuck) {
+    resolver_live_run_ = r.speed_rev_per_s != prev.speed_rev_per_s ? resolver_live_run_ + 1 : 0;
+    if (resolver_live_run_ >= p.stuck_resolver_clear_samples) {
+      a.clear(Part::Resolver);
+      resolver_cleared_ = true;
+      resolver_live_run_ = 0;
+    }
+  } else {
+    resolver_live_run_ = 0;
+  }
   // Stuck resolver: the same position again while the load cell changes.
   if (r.position_rev == prev.position_rev && c.check.load_cell_present) {
     if (pos_repeat_ == 0) {

@@ -68,6 +68,8 @@ class CornerSupervisor {
 
  private:
   void resume_after_dropout();
+  void resume_after_resolver();
+  void restart_calibrator();
   void react_to_new_findings();
   void rejoin();
   void refresh_view(const CornerReading* r, const SampleCheck* c, const calibration::Estimate* e);

@@ -130,6 +130,10 @@ struct MonitorParams {
   // quantised or quiet channel repeats; 0: the rule off).
   int stuck_frozen_samples = 20;
   double stuck_frozen_run_factor = 3.0;
+  // A stuck resolver that lives again: its speed (unquantised, noisy) changed in each of this
+  // many consecutive samples. The finding is cleared (the calibrator and the residual resume);
+  // a resolver offset is never cleared (a live reading is not a right one).
+  int stuck_resolver_clear_samples = 200;
 
   // Load-cell step at standstill (StepDetector): the position within step_still_span_rev over
   // step_still_samples, then the load cell off that window's mean by step_kN and beyond
@@ -237,6 +241,8 @@ class FaultMonitor {
   bool take_rejoin() { return link_.take_rejoin(); }
   // A dropout finding cleared (its values are back); true once per clearing.
   bool take_load_cell_cleared() { return dropout_.take_cleared(); }
+  // A stuck-resolver finding cleared (the resolver lives again); true once per clearing.
+  bool take_resolver_cleared() { return stuck_.take_resolver_cleared(); }
   // Whether the last loss was the process (liveliness), so its sequence starts again.
   bool process_was_lost() const { return link_.process_was_lost(); }
   // Delivered / expected torque, from the last torque check (1 until one ran).

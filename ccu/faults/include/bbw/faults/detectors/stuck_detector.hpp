@@ -15,6 +15,12 @@ class StuckDetector {
   void on_rejoin() { lc_repeat_ = pos_repeat_ = resolver_frozen_ = 0; }
   int load_cell_repeats() const { return lc_repeat_; }
   int position_repeats() const { return pos_repeat_; }
+  // A stuck-resolver finding cleared (the resolver lives again); true once per clearing.
+  bool take_resolver_cleared() {
+    const bool c = resolver_cleared_;
+    resolver_cleared_ = false;
+    return c;
+  }
 
  private:
   int lc_repeat_ = 0;
@@ -27,6 +33,8 @@ class StuckDetector {
   int resolver_frozen_ = 0;
   double resolver_frozen_onset_s_ = 0.0;
   int longest_lc_run_ = 0, longest_resolver_run_ = 0;
+  int resolver_live_run_ = 0;  // consecutive samples whose speed changed, while diagnosed stuck
+  bool resolver_cleared_ = false;
 };
 
 }  // namespace bbw::faults
