@@ -361,6 +361,61 @@ TEST(FaultMonitor, DeadlineLivelinessAndRejoin) {
   EXPECT_FALSE(m.take_rejoin());
 }
 
+// Lockstep: blocks arrive at the period ends and the CCU ticks after each period's arrivals. Three
+// periods without a block (an arrival gap of 20 ms, a 22 ms delay's) reach the 15 ms deadline at
+// the third period's tick; two (a gap of 15 ms) do not, the late block arrives before that tick.
+TEST(FaultMonitor, InLockstepThreeMissingPeriodsAreALostLinkAndTwoAreNot) {
+  auto run = [](int missing_periods) {
+    MonitorParams p;
+    FaultMonitor m(p, Target::RL);
+    SampleCheck ok;
+    for (int k = 1; k <= 30; ++k) {
+      const double t = 0.005 * k;
+      if (k <= 10 || k > 10 + missing_periods) m.update(at(static_cast<std::uint64_t>(k), t), ok, nullptr, 5.0, t);
+      m.tick(t);
+    }
+    return m.diagnosis(Part::Network);
+  };
+  const Diagnosis three = run(3);
+  ASSERT_TRUE(three.present);
+  EXPECT_EQ(three.finding, Finding::LinkLost);
+  EXPECT_NEAR(three.onset_s, 0.050, 1e-12);
+  EXPECT_NEAR(three.detected_s, 0.065, 1e-12);
+  EXPECT_FALSE(run(2).present);
+}
+
+// A delay loses no sample: a corner whose first sample after the outage continues its sequence
+// keeps every detector's state (tuning seed 1401 run 289: the end-of-line friction model's reset
+// at a delayed corner's rejoin made the reversal 1 ms later look like a noisy load cell). Seen
+// through the frozen rule: a load cell frozen for 11 samples before a 20 ms outage and 10 after
+// is stuck when the sequence continues, and not when it starts again (a new incarnation, whose
+// first samples say nothing of the old one's).
+TEST(FaultMonitor, ADelayedCornerKeepsItsDetectorsAcrossTheOutage) {
+  auto run = [](bool continues) {
+    MonitorParams p;
+    FaultMonitor m(p, Target::FR);
+    SampleCheck ok;
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> n01(0.0, 1.0);
+    double frozen_kN = 0.0;
+    for (int k = 1; k <= 110; ++k) {
+      const double t = 0.001 * k;
+      const bool late = k > 100;  // held back by the outage, delivered 20 ms late
+      auto r = at(static_cast<std::uint64_t>(continues || !late ? k : k - 100), t, 3.0 + 2e-4 * k, 10.0 + 0.03 * n01(rng));
+      r.speed_rev_per_s = 0.2 + 0.005 * n01(rng);
+      if (k == 90) frozen_kN = r.force_kN;
+      if (k >= 90) r.force_kN = frozen_kN;
+      if (k == 101) m.tick(0.121);  // the outage: nothing for 20 ms
+      m.update(r, ok, nullptr, r.force_kN, late ? t + 0.020 : t);
+    }
+    return m;
+  };
+  const FaultMonitor delayed = run(true);
+  EXPECT_TRUE(delayed.diagnosis(Part::Network).present);
+  EXPECT_EQ(delayed.diagnosis(Part::LoadCell).finding, Finding::LoadCellStuck);
+  EXPECT_TRUE(run(false).ok(Part::LoadCell));
+}
+
 // A restarted process (new incarnation) that rejoins before the participant lease ran out: the
 // open link outage is renamed the process's death, from the link's onset; a process already
 // named is left as it was.

@@ -156,9 +156,12 @@ void FaultMonitor::set_curve_range(double min_rev, double max_rev) {
 
 void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, const calibration::Estimate* estimate,
                           double force_estimate_kN, double arrival_s) {
-  // Any arrival, even a corrupt one, shows that the corner is there; the end of an outage
-  // breaks every detector's continuity.
-  if (link_.on_arrival(arrival_s, arbiter_)) {
+  // Any arrival, even a corrupt one, shows that the corner is there; the end of an outage that
+  // lost samples breaks every detector's continuity. A delay loses none: when the first sample
+  // after the outage continues the corner's sequence, every detector keeps its state (resetting the end-of-line friction model's made a reversal
+  // 1 ms after a delayed corner rejoined look like a noisy load cell: tuning seed 1401 run 289).
+  const bool continues = have_prev_ && r.seq == prev_.seq + 1;
+  if (link_.on_arrival(arrival_s, arbiter_) && !continues) {
     have_prev_ = false;
     noise_.on_rejoin();
     tracking_.on_rejoin();
