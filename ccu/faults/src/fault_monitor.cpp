@@ -158,8 +158,9 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
                           double force_estimate_kN, double arrival_s) {
   // Any arrival, even a corrupt one, shows that the corner is there; the end of an outage that
   // lost samples breaks every detector's continuity. A delay loses none: when the first sample
-  // after the outage continues the corner's sequence, every detector keeps its state (resetting the end-of-line friction model's made a reversal
-  // 1 ms after a delayed corner rejoined look like a noisy load cell: tuning seed 1401 run 289).
+  // after the outage continues the corner's sequence, every detector keeps its state (resetting
+  // the end-of-line friction model made a reversal 1 ms after a delayed corner rejoined look like
+  // a noisy load cell: tuning seed 1401 run 289).
   const bool continues = have_prev_ && r.seq == prev_.seq + 1;
   if (link_.on_arrival(arrival_s, arbiter_) && !continues) {
     have_prev_ = false;

@@ -86,7 +86,8 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, const Monito
   } else {
     static_min_make_Nm_ = std::min(static_min_make_Nm_, make_Nm_);
   }
-  const bool on_command = std::isfinite(r.force_command_kN) && std::abs(r.force_command_kN - load_kN) <= p.seized_force_error_kN;
+  const bool on_command =
+      std::isfinite(r.force_command_kN) && std::abs(r.force_command_kN - load_kN) <= p.seized_force_error_kN;
   // The loop winds up against a rotor that does not turn. (Not down: a healthy hold's current
   // may fall to about 0 A while the drive's and the keys' friction hold the load; tried on the
   // tuning seed, 3 fault-free false alarms in hard stops.)
