@@ -42,6 +42,15 @@ std::string small_spec(const std::string& dir, int runs) {
   return file;
 }
 
+// The small spec with one piece of it replaced (`from` must be in it).
+std::string small_spec_with(const std::string& dir, int runs, const std::string& from, const std::string& to) {
+  const std::string file = small_spec(dir, runs);
+  std::string text = slurp(file);
+  text.replace(text.find(from), from.size(), to);
+  std::ofstream(file) << text;
+  return file;
+}
+
 }  // namespace
 
 // The CI subset (config/campaigns/ci.yaml, 36 runs, every kind, onset and profile): every fault
@@ -89,10 +98,7 @@ TEST(CampaignSystem, CiSubsetOverDdsIsNoWorseThanMeasured) {
 // result, 289 of tune_c's 600 when it first asked for 60 members of a 30-member population).
 TEST(CampaignSystem, MembersBeyondThePopulationAreRefusedAtThePlan) {
   const std::string dir = bbw::system_test::scratch("campaign", "members");
-  const std::string spec = small_spec(dir, 3);
-  std::string text = slurp(spec);
-  text.replace(text.find("members: 30"), 11, "members: 31");
-  std::ofstream(spec) << text;
+  const std::string spec = small_spec_with(dir, 3, "members: 30", "members: 31");
   const auto r = bbw::system_test::run("plan", {bin("bbw_campaign"), "plan", spec, "--out", dir + "/c"}, dir, 60s);
   EXPECT_FALSE(r.status.ok());
   EXPECT_NE(r.err.find(spec + ":6: key 'population.members': must be at most the population's count (30 in "),
@@ -106,10 +112,7 @@ TEST(CampaignSystem, MembersBeyondThePopulationAreRefusedAtThePlan) {
 // campaign said "plots not written").
 TEST(CampaignSystem, AFaultFreeCampaignReportsItsFalseAlarmRateAndNoCoverage) {
   const std::string dir = bbw::system_test::scratch("campaign", "fault_free");
-  const std::string spec = small_spec(dir, 2);
-  std::string text = slurp(spec);
-  text.replace(text.find("fault_free_share: 0.34"), 22, "fault_free_share: 1.0");
-  std::ofstream(spec) << text;
+  const std::string spec = small_spec_with(dir, 2, "fault_free_share: 0.34", "fault_free_share: 1.0");
   const auto r = campaign(dir, "ff", {spec, "--out", dir + "/c", "--jobs", "2", "--transport", "memory"}, 120s);
   ASSERT_TRUE(r.status.ok()) << r.status.describe() << r.err;
   EXPECT_NE(r.out.find("small: no fault injected, false alarms 0 in 0.01 h fault-free"), std::string::npos) << r.out;

@@ -101,6 +101,15 @@ bbw::calibration::Estimate uncalibrated(double lc) {
 // Noiseless synthetic channels repeat exactly, which the frozen rule (a live channel's noise never
 // repeats an unquantised value) takes for stuck sensors: tests of the other rules on such
 // signals turn it off.
+// From sample `from` on, the resolver repeats what it read at `from` (position and speed).
+void stick_resolver(CornerReading& r, CornerReading& held, int k, int from) {
+  if (k == from) held = r;
+  if (k >= from) {
+    r.position_rev = held.position_rev;
+    r.speed_rev_per_s = held.speed_rev_per_s;
+  }
+}
+
 MonitorParams noiseless() {
   MonitorParams p;
   p.stuck_frozen_run_factor = 0.0;
@@ -258,12 +267,9 @@ TEST(FaultMonitor, AChannelFrozenInAHoldIsStuck) {
       auto r = at(k, t, std::round((4.6 + 2e-5 * n01(rng)) / 2e-5) * 2e-5, lc);
       r.speed_rev_per_s = 0.005 * n01(rng);
       r.motor_current_A = lc * p.Nm_per_kN / p.torque_per_A_Nm;
-      if (k == lc_stuck_from || k == resolver_stuck_from) held = r;
+      if (k == lc_stuck_from) held = r;
       if (k >= lc_stuck_from) r.force_kN = held.force_kN;
-      if (k >= resolver_stuck_from) {
-        r.position_rev = held.position_rev;
-        r.speed_rev_per_s = held.speed_rev_per_s;
-      }
+      stick_resolver(r, held, k, resolver_stuck_from);
       m.update(r, ok, nullptr, r.force_kN, t);
     }
     return m;
@@ -305,22 +311,20 @@ TEST(FaultMonitor, ANoisyLoadCellIsFoundAfterTheResolverIsDiagnosed) {
                   force_kN + rms_kN * n01(rng));
       r.speed_rev_per_s = 0.25 * w * std::cos(w * t) + 0.005 * n01(rng);
       r.motor_current_A = 0.0;
-      if (k == 500) held = r;
-      if (k >= 500) {  // the resolver sticks at 0.5 s
-        r.position_rev = held.position_rev;
-        r.speed_rev_per_s = held.speed_rev_per_s;
-      }
+      stick_resolver(r, held, k, 500);  // the resolver sticks at 0.5 s
       m.update(r, ok, nullptr, r.force_kN, t);
     }
     return m;
   };
   const auto burst = run(0.25, 1.5);
   ASSERT_EQ(burst.diagnosis(Part::Resolver).finding, Finding::ResolverStuck);
-  EXPECT_EQ(burst.diagnosis(Part::LoadCell).finding, Finding::LoadCellNoisy) << to_string(burst.diagnosis(Part::LoadCell).finding) << " at " << burst.diagnosis(Part::LoadCell).detected_s;
+  EXPECT_EQ(burst.diagnosis(Part::LoadCell).finding, Finding::LoadCellNoisy)
+      << to_string(burst.diagnosis(Part::LoadCell).finding) << " at " << burst.diagnosis(Part::LoadCell).detected_s;
   EXPECT_LT(burst.diagnosis(Part::LoadCell).detected_s, 1.1);
   const auto healthy = run(0.05, 20.0);
   EXPECT_EQ(healthy.diagnosis(Part::Resolver).finding, Finding::ResolverStuck);
-  EXPECT_TRUE(healthy.ok(Part::LoadCell)) << to_string(healthy.diagnosis(Part::LoadCell).finding) << " at " << healthy.diagnosis(Part::LoadCell).detected_s;
+  EXPECT_TRUE(healthy.ok(Part::LoadCell))
+      << to_string(healthy.diagnosis(Part::LoadCell).finding) << " at " << healthy.diagnosis(Part::LoadCell).detected_s;
 }
 
 TEST(FaultMonitor, DropoutNeedsConsecutiveMissingValues) {
