@@ -78,8 +78,8 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
                    dds::Partition{dds::run_partition(options.participant.run_id)}),
       owners_(scenario.ccu_period_s) {
   if (options.vehicle) {
-    vehicle_in_ = std::make_unique<dds::DdsInlet<msg::VehicleSensorsPubSubType>>(
-        participant_, dds::kVehicleSensorsTopic, dds::profiles_for(true).measurement_reader, events,
+    vehicle_in_ = std::make_unique<dds::DdsInlet<msg::CaliperTemperaturesPubSubType>>(
+        participant_, dds::kCaliperTemperatureTopic, dds::profiles_for(true).measurement_reader, events,
         dds::Partition{dds::run_partition(options.participant.run_id)});
   }
   if (!options.periods_log.empty()) {
@@ -195,6 +195,10 @@ void CornerApp::drain_inputs() {
   }
 }
 
+bool CornerApp::vehicle_ready(std::uint64_t k, std::uint64_t first) const {
+  return vehicle_in_ == nullptr || k == first || vehicle_step_ >= node::caliper_temperature_step(k);
+}
+
 void CornerApp::simulate_period(std::uint64_t k) {
   if (const msg::MeasurementBlock* b = node_.simulate_period(k)) node_.block_sent(blocks_.send(*b));
 }
@@ -285,11 +289,10 @@ int CornerApp::run(std::string& error) {
     // Lockstep without a CCU (its command writer lost its liveliness): the corner runs on alone
     // under its watchdog.
     if (!lockstep || !node_.ccu_lost()) {
-      // A vehicle run: also the vehicle's period k - 1 (its caliper temperature for period k).
+      // A vehicle run: also the vehicle's caliper temperatures for period k.
       const runtime::PeriodStart begun = clock->begin(k, [&] {
         drain_inputs();
-        const bool vehicle_ready = vehicle_in_ == nullptr || k == first || vehicle_step_ >= static_cast<std::int64_t>(k) - 1;
-        return (node_.granted(k) && vehicle_ready) || ccu_gone() || node_.latest_command().stop();
+        return (node_.granted(k) && vehicle_ready(k, first)) || ccu_gone() || node_.latest_command().stop();
       });
       if (begun == runtime::PeriodStart::Interrupted) break;
       if (begun == runtime::PeriodStart::TimedOut) {
@@ -326,8 +329,7 @@ bool CornerApp::advance_on_receive() {
     const std::uint64_t k = next_k_;
     // The end, a stop, a lost CCU: run()'s loop carries on at next_k_.
     if (k >= node_.periods() || node_.latest_command().stop() || node_.ccu_lost() || ccu_gone()) return true;
-    const bool vehicle_ready = vehicle_in_ == nullptr || k == first_k_ || vehicle_step_ >= static_cast<std::int64_t>(k) - 1;
-    if (!node_.granted(k) || !vehicle_ready) return false;  // waits for more data
+    if (!node_.granted(k) || !vehicle_ready(k, first_k_)) return false;  // waits for more data
     simulate_period(k);
     ++next_k_;
   }

@@ -59,8 +59,9 @@ struct CornerOptions : runtime::ProcessOptions {
   // first period at or after it, from a released plant, with sample seq 1).
   std::uint32_t incarnation = 0;
   double resume_at_s = 0.0;
-  // A vehicle run (issue 15): the caliper's temperature comes from bbw_vehicle's VehicleSensors;
-  // in lockstep the corner simulates period k once the vehicle's period k - 1 is in.
+  // A vehicle run (issue 15): the caliper's temperature comes from bbw_vehicle's
+  // CaliperTemperatures (every N periods); in lockstep the corner simulates period k once the
+  // vehicle's message of node::caliper_temperature_step(k) is in.
   bool vehicle = false;
 };
 
@@ -116,9 +117,11 @@ class CornerApp {
   dds::DdsOutlet<msg::CornerHealthPubSubType> health_;
   dds::DdsInlet<msg::ClampCommandPubSubType> commands_;
   dds::DdsInlet<msg::CalibrationStatePubSubType> calibration_;
-  std::unique_ptr<dds::DdsInlet<msg::VehicleSensorsPubSubType>> vehicle_in_;  // a vehicle run only
-  msg::VehicleSensors vehicle_msg_;
-  std::int64_t vehicle_step_ = -1;  // newest VehicleSensors step applied
+  // A vehicle run only: the vehicle's CaliperTemperatures (every N periods, node::caliper_temperature_step).
+  std::unique_ptr<dds::DdsInlet<msg::CaliperTemperaturesPubSubType>> vehicle_in_;
+  msg::CaliperTemperatures vehicle_msg_;
+  std::int64_t vehicle_step_ = -1;  // newest CaliperTemperatures step applied
+  bool vehicle_ready(std::uint64_t k, std::uint64_t first) const;
 
   std::chrono::steady_clock::time_point t0_{};  // realtime: wall time of the first period
   std::unique_ptr<node::CornerPeriodsLog> periods_log_;

@@ -3,9 +3,11 @@
 // its wheels from locking and stays in lane; bad scenarios are refused with file, line and key.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/vehicle/tyre.hpp"
@@ -201,6 +203,45 @@ TEST(VehicleRun, TheCaliperTemperatureComesFromTheDriving) {
   const double vehicle_C = r.vehicle().state().wheels[0].caliper_C;
   EXPECT_GT(vehicle_C, s.caliper_C[0] + 2.0);
   EXPECT_NEAR(sensed, vehicle_C, 0.5);  // the plant's temperature sensor reads the vehicle's caliper
+}
+
+// The corners take the vehicle's caliper temperatures every N periods only (one small message per
+// N periods over DDS instead of the vehicle's sensors every period: docs/vehicle.md, "Speed"):
+// period k's plant uses the temperature of the newest sent step below k, as bbw_corner waits for.
+TEST(VehicleRun, TheCornersTakeTheCaliperTemperatureEveryNPeriods) {
+  constexpr std::uint64_t kN = msg::CALIPER_TEMPERATURE_EVERY_PERIODS;
+  static_assert(kN > 1);
+  EXPECT_EQ(node::caliper_temperature_step(0), -1);
+  EXPECT_EQ(node::caliper_temperature_step(kN - 1), -1);
+  EXPECT_EQ(node::caliper_temperature_step(kN), static_cast<std::int64_t>(kN) - 1);
+  EXPECT_EQ(node::caliper_temperature_step(2 * kN - 1), static_cast<std::int64_t>(kN) - 1);
+  EXPECT_TRUE(node::caliper_temperature_sent_after(kN - 1));
+  EXPECT_FALSE(node::caliper_temperature_sent_after(kN));
+
+  auto s = vehicle_run::load_vehicle_scenario(scen("dry_straight_100kmh"));
+  s.disc_C = {400.0, 40.0, 40.0, 40.0};  // FL's caliper warms all the time
+  vehicle_run::VehicleRun r(s, calibrator(), {});
+  std::vector<double> vehicle_C;  // the vehicle's FL caliper at the end of each period
+  std::size_t changes = 0;
+  double applied_before = r.in_process().corner(0).caliper_temperature_C();
+  EXPECT_TRUE(std::isnan(applied_before));  // the scenario's own temperature until the first send
+  while (r.step()) {
+    const std::uint64_t k = r.in_process().periods_done() - 1;  // the period just simulated
+    vehicle_C.push_back(r.vehicle().state().wheels[0].caliper_C);
+    const double applied = r.in_process().corner(0).caliper_temperature_C();  // for period k + 1
+    const std::int64_t step = node::caliper_temperature_step(k + 1);
+    if (step < 0) {
+      EXPECT_TRUE(std::isnan(applied)) << "period " << k;
+    } else {
+      ASSERT_EQ(applied, vehicle_C[static_cast<std::size_t>(step)]) << "period " << k;
+    }
+    if (!(applied == applied_before) && !(std::isnan(applied) && std::isnan(applied_before))) ++changes;
+    applied_before = applied;
+    if (k > 40 * kN) break;
+  }
+  EXPECT_EQ(vehicle_C.size(), 40 * kN + 2);
+  EXPECT_GT(vehicle_C.back(), vehicle_C.front());  // the caliper did warm: each send was a change
+  EXPECT_EQ(changes, 40u);  // after periods N - 1, 2N - 1, ..., 40N - 1
 }
 
 // UN R13-H Annex 6 Appendix 2's per-axle adhesion from simulated runs without anti-lock: a

@@ -57,7 +57,9 @@ class VehicleApp {
           return p;
         }()),
         sensors_(participant_, dds::kVehicleSensorsTopic, dds::profiles_for(true).measurement_writer, events,
-                 dds::Partition{dds::run_partition(o.participant.run_id)}) {
+                 dds::Partition{dds::run_partition(o.participant.run_id)}),
+        temperatures_(participant_, dds::kCaliperTemperatureTopic, dds::profiles_for(true).measurement_writer, events,
+                      dds::Partition{dds::run_partition(o.participant.run_id)}) {
     node_.set_run_id(o.participant.run_id);
     for (std::size_t slot = 0; slot < 4; ++slot) {
       blocks_[slot] = std::make_unique<BlockInlet>(
@@ -68,16 +70,18 @@ class VehicleApp {
   }
 
   int run(std::string& error) {
-    // Peers: every corner's block writer, and our sensors' readers (the CCU and the four corners).
+    // Peers: every corner's block writer, our sensors' reader (the CCU) and our temperatures'
+    // readers (the four corners).
     const bool found = events_.wait_for(options_.discovery_timeout, [&] {
-      bool all = sensors_.peers() >= 5;
+      bool all = sensors_.peers() >= 1 && temperatures_.peers() >= 4;
       for (const auto& b : blocks_) all = all && b->peers() >= 1;
       return all;
     });
     if (!found) {
       if (events_.interrupted()) return kExitOk;
       error = "CCU and corners not discovered within " + std::to_string(options_.discovery_timeout.count()) +
-              " ms (sensor readers matched " + std::to_string(sensors_.peers()) + " of 5)";
+              " ms (sensor readers matched " + std::to_string(sensors_.peers()) + " of 1, temperature readers " +
+              std::to_string(temperatures_.peers()) + " of 4)";
       return kExitDiscovery;
     }
     periods_ = node::periods_of(scenario_.corners.scenario);
@@ -88,7 +92,7 @@ class VehicleApp {
     if (dds::lockstep_on_receive()) {
       const auto end = dds::run_on_receive(events_, [this] { return advance_on_receive(); }, [this] { return periods_done_; });
       if (send_failed_) {
-        error = "VehicleSensors write failed at period " + std::to_string(periods_done_);
+        error = "VehicleSensors or CaliperTemperatures write failed at period " + std::to_string(periods_done_);
         return kExitRuntime;
       }
       k_from = end == dds::ReceiveRunEnd::Interrupted ? periods_ : periods_done_;
@@ -105,11 +109,12 @@ class VehicleApp {
         return kExitPeerLost;
       }
       if (!end_period(k)) {
-        error = "VehicleSensors write failed at period " + std::to_string(k);
+        error = "VehicleSensors or CaliperTemperatures write failed at period " + std::to_string(k);
         return kExitRuntime;
       }
     }
     sensors_.get().get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2, 0));
+    temperatures_.get().get().wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2, 0));
     return kExitOk;
   }
 
@@ -137,9 +142,18 @@ class VehicleApp {
     return all;
   }
 
-  // Integrates period k and publishes the vehicle's readings; false when the write failed.
+  // Integrates period k and publishes the vehicle's readings, and every N-th period the calipers'
+  // temperatures; false when a write failed.
   bool end_period(std::uint64_t k) {
-    if (!sensors_.send(node_.simulate_period(k, n_))) return false;
+    const msg::VehicleSensors& sensors = node_.simulate_period(k, n_);
+    if (!sensors_.send(sensors)) return false;
+    if (node::caliper_temperature_sent_after(k)) {
+      temperatures_msg_.run_id(sensors.run_id());
+      temperatures_msg_.step(sensors.step());
+      temperatures_msg_.time_s(sensors.time_s());
+      temperatures_msg_.caliper_temperature_C(sensors.caliper_temperature_C());
+      if (!temperatures_.send(temperatures_msg_)) return false;
+    }
     periods_done_ = k + 1;
     have_ = {};
     return true;
@@ -167,6 +181,8 @@ class VehicleApp {
   vehicle_run::VehicleNode node_;
   dds::Participant participant_;
   dds::DdsOutlet<msg::VehicleSensorsPubSubType> sensors_;
+  dds::DdsOutlet<msg::CaliperTemperaturesPubSubType> temperatures_;
+  msg::CaliperTemperatures temperatures_msg_;
   std::array<std::unique_ptr<BlockInlet>, 4> blocks_;
   std::array<bool, 4> lost_{};
   std::array<bool, 4> have_{};  // the corners' blocks of the period being waited for

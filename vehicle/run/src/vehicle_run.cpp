@@ -41,9 +41,12 @@ void VehicleRun::vehicle_period(std::uint64_t k) {
   const msg::PedalSample& pedal = pedal_.sample(k, run_.ccu().period_end_s(k));
   brake_.on_vehicle(sensors);
   brake_.on_pedal(pedal);
-  // The caliper temperatures the vehicle computed reach the corners' plants from the next period.
-  for (std::size_t i = 0; i < run_.corners(); ++i) {
-    run_.corner(i).set_caliper_temperature_C(sensors.caliper_temperature_C()[slot_of_channel_[i]]);
+  // Every N-th period the caliper temperatures the vehicle computed reach the corners' plants, from
+  // the next period on (bbw_vehicle's CaliperTemperatures; node::caliper_temperature_step).
+  if (node::caliper_temperature_sent_after(k)) {
+    for (std::size_t i = 0; i < run_.corners(); ++i) {
+      run_.corner(i).set_caliper_temperature_C(sensors.caliper_temperature_C()[slot_of_channel_[i]]);
+    }
   }
   run_.ccu().participant_done(vehicle_participant_, k);
   run_.ccu().participant_done(pedal_participant_, k);

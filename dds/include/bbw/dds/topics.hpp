@@ -13,6 +13,8 @@ inline constexpr const char* kHealthTopic = "bbw/CornerHealth";
 // measurement profiles (one sample per CCU period, the barrier's "period done").
 inline constexpr const char* kVehicleSensorsTopic = "bbw/VehicleSensors";
 inline constexpr const char* kPedalTopic = "bbw/PedalSample";
+// The vehicle's caliper temperatures to the corners, every N periods (idl/bbw_vehicle_msgs.idl).
+inline constexpr const char* kCaliperTemperatureTopic = "bbw/CaliperTemperatures";
 
 struct ProfileNames {
   const char* measurement_writer;

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <bbw/idl/bbw_msgs.h>
+#include <bbw/idl/bbw_vehicle_msgs.h>
 
 #include <array>
 #include <cstdint>
@@ -28,6 +29,19 @@
 #include "bbw/scenario/scenario.hpp"
 
 namespace bbw::node {
+
+// A vehicle run (issue 15): the vehicle sends the calipers' temperatures at the end of every N-th
+// period only (N = msg::CALIPER_TEMPERATURE_EVERY_PERIODS: periods N - 1, 2N - 1, ...).
+inline bool caliper_temperature_sent_after(std::uint64_t step) {
+  return (step + 1) % msg::CALIPER_TEMPERATURE_EVERY_PERIODS == 0;
+}
+// The step whose temperatures period k's plant uses: the newest sent step below k, or -1 (none
+// yet: the scenario's temperature) for the first N periods. Over DDS a corner waits for it; in
+// process the run applies each sent step from the next period on, which is the same.
+inline std::int64_t caliper_temperature_step(std::uint64_t k) {
+  const std::uint64_t n = msg::CALIPER_TEMPERATURE_EVERY_PERIODS;
+  return static_cast<std::int64_t>((k / n) * n) - 1;
+}
 
 struct CornerNodeOptions {
   Corner corner = Corner::FL;
@@ -106,6 +120,7 @@ class CornerNode {
   // A vehicle run (issue 15): the caliper's temperature as the vehicle computes it from the brake
   // disc, applied from the next period on; NaN (the default) keeps the scenario's conditions.
   void set_caliper_temperature_C(double temperature_C) { caliper_temperature_C_ = temperature_C; }
+  double caliper_temperature_C() const { return caliper_temperature_C_; }
 
   // Starts at the CCU's first command for our first period (the start signal). Returns the first
   // period to simulate.
