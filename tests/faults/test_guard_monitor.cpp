@@ -499,6 +499,35 @@ TEST(FaultMonitor, ABrakeThatDoesNotReleaseIsNamedAndOneThatMovesBackIsNot) {
   EXPECT_FALSE(run(8.0, 0.0, 1.0).present);   // 2 kN over: within the 3 kN threshold
 }
 
+// The corner's loop holds its load cell at the command, so a healthy clamp force stands off the
+// command by the key friction (stress population, 2026-11-26: a caliper with 2.7-3 kN of key
+// friction held its clamp force 3 kN above a falling command and was named not releasing). The
+// calibrated friction explains that part; a load cell that stays up with the force does not.
+TEST(FaultMonitor, AnExcessTheCalibratedKeyFrictionExplainsIsNotABrakeThatDoesNotRelease) {
+  MonitorParams p = noiseless();
+  SampleCheck ok;
+  auto run = [&](double lc_kN, bool calibrated) {
+    FaultMonitor m(p, Target::FL);
+    for (int k = 1; k <= 800; ++k) {
+      auto r = at(k, 0.001 * k, 4.0, k == 1 ? 10.0 : lc_kN);
+      r.force_command_kN = k == 1 ? 10.0 : 6.5;  // told to come down from 10 to 6.5 kN
+      // The clamp force stays at 10 kN: with the load cell at 6.5 kN the keys hold 3.5 kN
+      // (friction -3.5 kN); with it at 10 kN they hold nothing.
+      const auto e = fitted(calibrated, r.force_kN, r.force_kN - 10.0, 10.0);
+      m.update(r, ok, &e, e.force_kN, r.time_s);
+    }
+    return m.diagnosis(Part::Actuator);
+  };
+  EXPECT_FALSE(run(6.5, true).present);  // the load cell came down to the command: released
+  const Diagnosis seized = run(10.0, true);  // the load cell stayed up with the force: 3.5 kN over
+  ASSERT_TRUE(seized.present);
+  EXPECT_EQ(seized.finding, Finding::ActuatorNotReleasing);
+  // Before a fit the friction is not known: the 3.5 kN excess counts as before.
+  const Diagnosis uncalibrated = run(6.5, false);
+  ASSERT_TRUE(uncalibrated.present);
+  EXPECT_EQ(uncalibrated.finding, Finding::ActuatorNotReleasing);
+}
+
 // A part's finding is upgraded to not releasing (and finding_s records when); the first
 // detection time stays.
 TEST(FaultMonitor, ALostActuatorThatDoesNotReleaseIsUpgraded) {
@@ -809,6 +838,42 @@ TEST(FaultMonitor, ANoiseBurstIsFoundInTheRawLoadCellNotTheFilteredEstimate) {
     m.update(r, ok, &e, e.force_kN, r.time_s);
   }
   EXPECT_EQ(m.diagnosis(Part::LoadCell).finding, Finding::LoadCellNoisy);
+}
+
+// A healthy load cell noisier than the population's (0.1 kN RMS against at most 0.05 kN) is not
+// noisy once the corner has learnt its own level (noise.learned_factor, learn_time_constant_s:
+// stress population 2026-11-26, a 0.079 kN load cell named noisy at 6.8 s); a 0.35 kN RMS burst
+// on top of it still is.
+TEST(FaultMonitor, TheNoiseRuleLearnsTheCornersOwnLevel) {
+  SampleCheck ok;
+  auto run = [&](const MonitorParams& p, double burst_from_s) {
+    FaultMonitor m(p, Target::FL);
+    std::mt19937_64 rng(11);
+    std::normal_distribution<double> cell(0.0, 0.1), burst(0.0, 0.35);
+    for (int k = 1; k <= 30000; ++k) {
+      const double t = 0.001 * k;
+      const double lc = 30.0 + cell(rng) + (t >= burst_from_s ? burst(rng) : 0.0);
+      auto r = at(k, t, 5.8 + 2e-5 * ((k * 7) % 3), lc);
+      r.speed_rev_per_s = 0.004 * ((k % 3) - 1);
+      const auto e = estimate(30.0, 30.0);
+      m.update(r, ok, &e, e.force_kN, r.time_s);
+      if (m.diagnosis(Part::LoadCell).present) return m.diagnosis(Part::LoadCell);
+    }
+    return m.diagnosis(Part::LoadCell);
+  };
+  MonitorParams fixed;
+  fixed.noise_learned_factor = 0.0;  // the fixed step alone: this load cell looks noisy
+  const Diagnosis before = run(fixed, 1e9);
+  ASSERT_TRUE(before.present);
+  EXPECT_EQ(before.finding, Finding::LoadCellNoisy);
+  const MonitorParams learnt;
+  const Diagnosis healthy = run(learnt, 1e9);
+  EXPECT_FALSE(healthy.present) << "named " << to_string(healthy.finding) << " at " << healthy.detected_s << " s";
+  const Diagnosis burst = run(learnt, 10.0);
+  ASSERT_TRUE(burst.present);
+  EXPECT_EQ(burst.finding, Finding::LoadCellNoisy);
+  EXPECT_GE(burst.detected_s, 10.0);
+  EXPECT_LT(burst.detected_s, 10.1);
 }
 
 // With an end-of-line curve the noise rule reads the load cell against it (issue 14): a fast

@@ -74,6 +74,9 @@ void MonitorParams::validate() const {
           noise_window_samples, "must be in [4, 256]");
   positive("noise_step_kN", noise_step_kN);
   positive("noise_second_difference_kN", noise_second_difference_kN);
+  require(std::isfinite(noise_learned_factor) && noise_learned_factor >= 0.0, "noise_learned_factor",
+          noise_learned_factor, "must be finite and >= 0");
+  positive("noise_learn_time_constant_s", noise_learn_time_constant_s);
   require(noise_min_fraction > 0.0 && noise_min_fraction <= 1.0, "noise_min_fraction", noise_min_fraction,
           "must be in (0, 1]");
   require(dropout_samples >= 1, "dropout_samples", dropout_samples, "must be >= 1");
@@ -193,7 +196,9 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   if (commutation_lost()) {
     tracking_.on_rejoin();
   } else {
-    tracking_.update(c, force_estimate_kN, p_, arbiter_);
+    const bool friction_known = estimate != nullptr && estimate->valid && estimate->calibrated && check.load_cell_present &&
+                                arbiter_.ok(Part::LoadCell);
+    tracking_.update(c, force_estimate_kN, friction_known ? estimate->friction_kN : 0.0, p_, arbiter_);
   }
 
   prev_ = r;

@@ -1,5 +1,6 @@
 #include "bbw/faults/detectors/noise_detector.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "bbw/faults/fault_monitor.hpp"
@@ -18,7 +19,26 @@ void NoiseDetector::update(double residual_kN, double model_kN, double t, const 
   const double model_step_kN = std::isfinite(model_kN - prev_model_kN_) ? std::abs(model_kN - prev_model_kN_) : 0.0;
   prev_residual_kN_ = residual_kN;
   prev_model_kN_ = model_kN;
-  count(std::abs(d) > p.noise_step_kN + model_step_kN, t, p, a);
+  // The learnt level counts once a whole time constant was learnt (a burst early in the run must
+  // not be learnt as the healthy level before it is seen).
+  const bool learnt = learnt_s_ >= p.noise_learn_time_constant_s;
+  const double step_kN = learnt ? std::max(p.noise_step_kN, p.noise_learned_factor * mean_abs_step_kN_) : p.noise_step_kN;
+  count(std::abs(d) > step_kN + model_step_kN, t, p, a);
+  // Learn the healthy level while the window is below a finding (a burst is found within a
+  // window, about 1/30 of the time constant: it moves the level by a few per cent at most).
+  if (std::isfinite(d) && fraction_ < p.noise_min_fraction) {
+    const double dt_s = have_learn_time_ ? t - learn_time_s_ : 0.0;
+    if (dt_s > 0.0) {
+      // The plain mean of what was learnt until the time constant is reached, then exponential.
+      learnt_s_ += dt_s;
+      const double weight = std::min(1.0, dt_s / std::min(learnt_s_, p.noise_learn_time_constant_s));
+      mean_abs_step_kN_ += (std::abs(d) - mean_abs_step_kN_) * weight;
+    }
+    have_learn_time_ = true;
+    learn_time_s_ = t;
+  } else {
+    have_learn_time_ = false;
+  }
 }
 
 void NoiseDetector::update_load_cell_difference(double difference_kN, double t, const MonitorParams& p,

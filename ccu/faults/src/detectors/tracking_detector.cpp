@@ -7,8 +7,8 @@
 
 namespace bbw::faults {
 
-void TrackingDetector::update(const SampleContext& c, double force_estimate_kN, const MonitorParams& p,
-                              DiagnosisArbiter& a) {
+void TrackingDetector::update(const SampleContext& c, double force_estimate_kN, double friction_kN,
+                              const MonitorParams& p, DiagnosisArbiter& a) {
   const CornerReading& r = c.r;
   const double t = r.time_s;
   const double cmd = r.force_command_kN;
@@ -27,7 +27,10 @@ void TrackingDetector::update(const SampleContext& c, double force_estimate_kN, 
   // faster than the model, or an apply faster than it, is not a fault).
   const double limit = std::max(p.tracking_threshold_kN, p.tracking_relative * std::abs(cmd));
   const bool reachable = cmd <= p.force_limit_kN;
-  if (reachable && std::min(cmd, model_kN_) - force_estimate_kN > limit) {
+  // Friction above zero holds the clamp force below the load cell (so below the command), below
+  // zero above it.
+  const double f = std::isfinite(friction_kN) ? friction_kN : 0.0;
+  if (reachable && std::min(cmd, model_kN_) - (force_estimate_kN + std::max(f, 0.0)) > limit) {
     if (!tracking_suspect_) {
       tracking_suspect_ = true;
       tracking_onset_s_ = t;
@@ -39,7 +42,7 @@ void TrackingDetector::update(const SampleContext& c, double force_estimate_kN, 
   // Over-application: the brake holds a force well above what it is told and was told. Any
   // command counts (a brake told to release must release, whatever the force limit).
   const bool moving_back = r.speed_rev_per_s < -p.release_min_speed_rev_per_s;
-  if (!moving_back && force_estimate_kN - std::max(cmd, model_kN_) > limit) {
+  if (!moving_back && force_estimate_kN + std::min(f, 0.0) - std::max(cmd, model_kN_) > limit) {
     if (!excess_suspect_) {
       excess_suspect_ = true;
       excess_onset_s_ = t;

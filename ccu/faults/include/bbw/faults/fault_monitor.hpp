@@ -156,6 +156,13 @@ struct MonitorParams {
   // 0.25 kN RMS burst's; the clamp force's own second difference is below 0.03 kN per sample
   // even in 10 Hz ABS modulation).
   double noise_second_difference_kN = 0.35;
+  // The corner's own healthy level: the mean |step| of the residual, learnt with this time
+  // constant while the window holds less than half noise_min_fraction big steps. A step counts as
+  // big beyond max(noise_step_kN, noise_learned_factor x that mean) (Gaussian: the mean |step| is
+  // 0.8 sigma, so 4x is 3.2 sigma; for a 0.05 kN load cell it stays below 0.25 kN, for a 0.08 kN
+  // one it is about 0.36 kN). 0: the fixed step only.
+  double noise_learned_factor = 4.0;
+  double noise_learn_time_constant_s = 1.0;
 
   // Dropout: consecutive samples without a load-cell value.
   int dropout_samples = 5;

@@ -4,6 +4,7 @@
 // (model_kN, what the residual is taken against) is allowed on top: where the load cell follows
 // the model late (a 5 ms sensor delay at an ABS reversal, the key friction flipping by 2 kN
 // within 5 ms) the residual steps twice, once with the model and once with the load cell.
+// The step threshold rises with the corner's own learnt healthy level (noise_learned_factor).
 // Memory sized at compile time (kMaxNoiseWindow).
 #pragma once
 
@@ -24,6 +25,8 @@ class NoiseDetector {
   void update_load_cell_difference(double difference_kN, double t, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() { have_prev_residual_ = have_prev_difference_ = false; }
   double fraction() const { return fraction_; }
+  // The corner's learnt healthy mean |residual step| (noise_learned_factor).
+  double mean_abs_step_kN() const { return mean_abs_step_kN_; }
 
  private:
   bool have_prev_residual_ = false;
@@ -37,6 +40,10 @@ class NoiseDetector {
   int head_ = 0;
   int big_count_ = 0;
   double fraction_ = 0.0;  // share of big steps in the window
+  double mean_abs_step_kN_ = 0.0;  // learnt from 0: the fixed step alone until it has grown
+  bool have_learn_time_ = false;
+  double learnt_s_ = 0.0;  // time learnt so far
+  double learn_time_s_ = 0.0;
 };
 
 }  // namespace bbw::faults
