@@ -157,8 +157,9 @@ struct MonitorParams {
   // even in 10 Hz ABS modulation).
   double noise_second_difference_kN = 0.35;
   // The corner's own healthy level: the mean |step| of the residual, learnt with this time
-  // constant while the window holds less than half noise_min_fraction big steps. A step counts as
-  // big beyond max(noise_step_kN, noise_learned_factor x that mean) (Gaussian: the mean |step| is
+  // constant while the window is below a finding (noise_min_fraction), counted once a whole time
+  // constant is learnt. A step then counts as big beyond max(noise_step_kN, noise_learned_factor x
+  // that mean) (Gaussian: the mean |step| is
   // 0.8 sigma, so 4x is 3.2 sigma; for a 0.05 kN load cell it stays below 0.25 kN, for a 0.08 kN
   // one it is about 0.36 kN). 0: the fixed step only.
   double noise_learned_factor = 4.0;

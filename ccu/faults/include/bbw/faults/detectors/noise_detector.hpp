@@ -25,8 +25,6 @@ class NoiseDetector {
   void update_load_cell_difference(double difference_kN, double t, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() { have_prev_residual_ = have_prev_difference_ = false; }
   double fraction() const { return fraction_; }
-  // The corner's learnt healthy mean |residual step| (noise_learned_factor).
-  double mean_abs_step_kN() const { return mean_abs_step_kN_; }
 
  private:
   bool have_prev_residual_ = false;
