@@ -10,6 +10,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -91,7 +92,9 @@ class CcuApp {
   void link_back();
   void write_failover_stats() const;
   double realtime_now_s() const;
-  void drain_vehicle();
+  // A vehicle run: the vehicle's and the pedal's readings up to period k into the brake functions
+  // and the barrier; the pedal's later samples wait in pedal_ahead_.
+  void drain_vehicle(std::uint64_t k);
   // Lockstep on the receiving thread (bbw/dds/receive_runner.hpp): the period whose blocks are
   // complete is ended where the last one arrives and the next one begun (plan, commands); true
   // when run()'s loop must carry on at next_k_ (a failure, the end).
@@ -152,6 +155,11 @@ class CcuApp {
   std::size_t vehicle_participant_ = 0, pedal_participant_ = 0;
   msg::VehicleSensors vehicle_msg_;
   msg::PedalSample pedal_msg_;
+  // The pedal runs ahead of the barrier (vehicle_run::pedal_sample_allowed: at most
+  // kPedalLeadPeriods + N periods); its samples wait here in order, each for its own period.
+  static constexpr std::size_t kPedalAheadMax = 64;
+  std::deque<msg::PedalSample> pedal_ahead_;
+  std::uint64_t pedal_ahead_overflows_ = 0;  // samples beyond kPedalAheadMax, dropped
   // Lockstep on the receiving thread: the period whose blocks are awaited, whether its commands
   // were sent, and a corner's failure seen there.
   std::uint64_t next_k_ = 0;
