@@ -96,7 +96,7 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
     const dds::Partition run{dds::run_partition(options.participant.run_id)};
     vehicle_in_ = std::make_unique<dds::DdsInlet<msg::VehicleSensorsPubSubType>>(
         participant_, dds::kVehicleSensorsTopic, dds::profiles_for(true).measurement_reader, events, run);
-    pedal_in_ = std::make_unique<dds::DdsInlet<msg::PedalSamplePubSubType>>(
+    pedal_in_ = std::make_unique<dds::DdsInlet<msg::PedalSamplesPubSubType>>(
         participant_, dds::kPedalTopic, dds::profiles_for(true).measurement_reader, events, run);
     vehicle_participant_ = node_.add_participant("vehicle");
     pedal_participant_ = node_.add_participant("pedal");
@@ -149,11 +149,16 @@ void CcuApp::drain_vehicle(std::uint64_t k) {
   }
   while (pedal_in_->take(pedal_msg_)) {
     if (pedal_msg_.run_id() != options_.participant.run_id) continue;
-    if (pedal_ahead_.size() >= kPedalAheadMax) {
-      ++pedal_ahead_overflows_;
-      continue;
+    for (const msg::PedalSample& p : pedal_msg_.samples()) {
+      if (p.run_id() != options_.participant.run_id || p.step() != pedal_next_step_) {
+        ++pedal_rejected_;
+      } else if (pedal_ahead_.size() >= kPedalAheadMax) {
+        ++pedal_ahead_overflows_;
+      } else {
+        pedal_ahead_.push_back(p);
+        ++pedal_next_step_;
+      }
     }
-    pedal_ahead_.push_back(pedal_msg_);
   }
   while (!pedal_ahead_.empty() && pedal_ahead_.front().step() <= k) {
     brake_->on_pedal(pedal_ahead_.front());
@@ -558,9 +563,9 @@ int CcuApp::run(std::string& error) {
   wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
   sim_s_ = static_cast<double>(periods_done_) * T;
   write_failover_stats();
-  if (pedal_ahead_overflows_ > 0) {
-    std::cerr << "bbw_ccu (" << options_.role << "): " << pedal_ahead_overflows_
-              << " pedal samples lost: the pedal ran more than " << kPedalAheadMax << " periods ahead" << std::endl;
+  if (pedal_ahead_overflows_ > 0 || pedal_rejected_ > 0) {
+    std::cerr << "bbw_ccu (" << options_.role << "): pedal samples dropped: " << pedal_ahead_overflows_
+              << " more than " << kPedalAheadMax << " periods ahead, " << pedal_rejected_ << " out of order" << std::endl;
   }
   if (stash_overflows_ > 0) {
     std::cerr << "bbw_ccu (" << options_.role << "): " << stash_overflows_

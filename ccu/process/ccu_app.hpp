@@ -150,16 +150,18 @@ class CcuApp {
   std::vector<std::pair<std::uint64_t, std::size_t>> restarts_;  // lockstep: (step, slot)
   // A vehicle run: the vehicle's and the pedal's readings, their barrier places, the brake functions.
   std::unique_ptr<dds::DdsInlet<msg::VehicleSensorsPubSubType>> vehicle_in_;
-  std::unique_ptr<dds::DdsInlet<msg::PedalSamplePubSubType>> pedal_in_;
+  std::unique_ptr<dds::DdsInlet<msg::PedalSamplesPubSubType>> pedal_in_;
   std::optional<vehicle_run::BrakeFunctions> brake_;
   std::size_t vehicle_participant_ = 0, pedal_participant_ = 0;
   msg::VehicleSensors vehicle_msg_;
-  msg::PedalSample pedal_msg_;
+  msg::PedalSamples pedal_msg_;
   // The pedal runs ahead of the barrier (vehicle_run::pedal_sample_allowed: at most
   // kPedalLeadPeriods + N periods); its samples wait here in order, each for its own period.
   static constexpr std::size_t kPedalAheadMax = 64;
   std::deque<msg::PedalSample> pedal_ahead_;
+  std::uint64_t pedal_next_step_ = 0;        // the step the next pedal sample must have
   std::uint64_t pedal_ahead_overflows_ = 0;  // samples beyond kPedalAheadMax, dropped
+  std::uint64_t pedal_rejected_ = 0;         // samples out of order (not the next step), dropped
   // Lockstep on the receiving thread: the period whose blocks are awaited, whether its commands
   // were sent, and a corner's failure seen there.
   std::uint64_t next_k_ = 0;

@@ -1,6 +1,7 @@
 #include "bbw/dds/participant.hpp"
 
 #include <bbw/idl/bbw_msgsTypeObject.h>
+#include <bbw/idl/bbw_vehicle_msgsTypeObject.h>
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
@@ -58,8 +59,14 @@ Participant::Participant(const ParticipantOptions& options)
                                                  : fdds::Log::Kind::Error);
   }
   // Content filters need the TypeObjects, which are otherwise registered only when a message
-  // object is first constructed.
+  // object is first constructed. Every process registers all of them before its participant
+  // exists: Fast DDS 2.9 builds a discovered writer's type from its TypeObject on a receive thread
+  // (PDP::check_and_notify_type_discovery) and adds identifiers it does not know to the process's
+  // TypeObjectFactory without a lock against the other threads doing the same; a sequence type
+  // not registered here (PedalSamples, in the corners) crashed a corner in 3 of 12 vehicle runs
+  // (TypeIdentifier::_d in TypeObjectFactory::get_sequence_identifier). Known, they are only looked up.
   registerbbw_msgsTypes();
+  registerbbw_vehicle_msgsTypes();
   const std::string file = options.profiles_file.empty() ? default_profiles_file() : options.profiles_file;
   load_profiles(file);
 

@@ -1,6 +1,7 @@
 // bbw_pedal: the instrumented brake pedal over Fast DDS (issue 15, docs/vehicle.md): the driver's
 // travel profile read by a travel and a force sensor (vehicle_run::PedalNode). A lockstep
-// participant of the CCU's barrier that publishes PedalSample k in the run's partition. It starts
+// participant of the CCU's barrier that publishes PedalSample k (in PedalSamples messages of
+// consecutive periods) in the run's partition. It starts
 // on the CCU's first grant (its command for the front-left corner, read in that corner's partition
 // of the run, then no longer read); after it, the pedal (open loop) runs ahead of the barrier, paced
 // by the vehicle's CaliperTemperatures (vehicle_run::pedal_sample_allowed).
@@ -62,6 +63,8 @@ class PedalApp {
         pace_(participant_, dds::kCaliperTemperatureTopic, dds::profiles_for(true).measurement_reader, events,
               dds::Partition{dds::run_partition(o.participant.run_id)}) {
     node_.set_run_id(o.participant.run_id);
+    batch_.run_id(o.participant.run_id);
+    batch_.samples().reserve(msg::PEDAL_SAMPLES_MAX);
   }
 
   int run(std::string& error) {
@@ -91,14 +94,15 @@ class PedalApp {
     if (dds::lockstep_on_receive()) {
       const auto end = dds::run_on_receive(events_, [this] { return advance_on_receive(); }, [this] { return periods_done_; });
       if (send_failed_) {
-        error = "PedalSample write failed at period " + std::to_string(periods_done_);
+        error = "PedalSamples write failed at period " + std::to_string(periods_done_);
         return kExitRuntime;
       }
       k_from = end == dds::ReceiveRunEnd::Interrupted ? periods_ : periods_done_;
     }
     runtime::LockstepClock period_clock(events_, options_.peer_timeout);
     period_clock.start(k_from);
-    for (std::uint64_t k = k_from; k < periods_ && !events_.interrupted(); ++k) {
+    while (periods_done_ < periods_ && k_from < periods_ && !events_.interrupted()) {
+      const std::uint64_t k = periods_done_;
       // Lockstep only: the clock policy of bbw/runtime/period_clock.hpp.
       const runtime::PeriodStart begun = period_clock.begin(k, [&] { return paced(k); });
       if (begun == runtime::PeriodStart::Interrupted) break;
@@ -108,8 +112,8 @@ class PedalApp {
                 ") not in within " + std::to_string(options_.peer_timeout.count()) + " ms";
         return kExitPeerLost;
       }
-      if (!send_sample(k)) {
-        error = "PedalSample write failed at period " + std::to_string(k);
+      if (!send_allowed()) {
+        error = "PedalSamples write failed at period " + std::to_string(periods_done_);
         return kExitRuntime;
       }
     }
@@ -140,27 +144,32 @@ class PedalApp {
     return vehicle_run::pedal_sample_allowed(k, vehicle_done_);
   }
 
-  // Publishes period k's sample; false when the write failed.
-  bool send_sample(std::uint64_t k) {
+  // Publishes every sample the pace allows, PEDAL_SAMPLES_MAX to a message; false when a write failed.
+  bool send_allowed() {
     // The period's end, computed as the CCU does (k T, then + T).
     const double T = scenario_.corners.scenario.ccu_period_s;
-    const double t_end = static_cast<double>(k) * T + T;
-    if (!samples_.send(node_.sample(k, t_end))) return false;
-    periods_done_ = k + 1;
+    while (periods_done_ < periods_ && vehicle_run::pedal_sample_allowed(periods_done_, vehicle_done_)) {
+      batch_.samples().clear();
+      for (std::uint64_t k = periods_done_; k < periods_ && batch_.samples().size() < msg::PEDAL_SAMPLES_MAX &&
+                                            vehicle_run::pedal_sample_allowed(k, vehicle_done_);
+           ++k) {
+        batch_.samples().push_back(node_.sample(k, static_cast<double>(k) * T + T));
+      }
+      if (!samples_.send(batch_)) return false;
+      periods_done_ += batch_.samples().size();
+    }
     return true;
   }
 
   // Every sample the vehicle's pace allows; true when run()'s loop must carry on (the end, a failed write).
   bool advance_on_receive() {
-    for (;;) {
-      const std::uint64_t k = periods_done_;
-      if (k >= periods_ || events_.interrupted()) return true;
-      if (!paced(k)) return false;
-      if (!send_sample(k)) {
-        send_failed_ = true;
-        return true;
-      }
+    if (periods_done_ >= periods_ || events_.interrupted()) return true;
+    if (!paced(periods_done_)) return false;
+    if (!send_allowed()) {
+      send_failed_ = true;
+      return true;
     }
+    return periods_done_ >= periods_;
   }
 
   const vehicle_run::VehicleScenario& scenario_;
@@ -168,7 +177,8 @@ class PedalApp {
   dds::Events& events_;
   vehicle_run::PedalNode node_;
   dds::Participant participant_;
-  dds::DdsOutlet<msg::PedalSamplePubSubType> samples_;
+  dds::DdsOutlet<msg::PedalSamplesPubSubType> samples_;
+  msg::PedalSamples batch_;
   std::unique_ptr<GrantInlet> grants_;  // until the first grant
   dds::DdsInlet<msg::CaliperTemperaturesPubSubType> pace_;
   msg::ClampCommand command_;
