@@ -96,7 +96,7 @@ CcuApp::CcuApp(const scenario::Scenario& scenario, const calibration::Calibrator
     const dds::Partition run{dds::run_partition(options.participant.run_id)};
     vehicle_in_ = std::make_unique<dds::DdsInlet<msg::VehicleSensorsPubSubType>>(
         participant_, dds::kVehicleSensorsTopic, dds::profiles_for(true).measurement_reader, events, run);
-    pedal_in_ = std::make_unique<dds::DdsInlet<msg::PedalSamplesPubSubType>>(
+    pedal_in_ = std::make_unique<dds::DdsInlet<msg::PedalSamplePubSubType>>(
         participant_, dds::kPedalTopic, dds::profiles_for(true).measurement_reader, events, run);
     vehicle_participant_ = node_.add_participant("vehicle");
     pedal_participant_ = node_.add_participant("pedal");
@@ -140,7 +140,7 @@ void CcuApp::drain_health() {
 }
 
 // A vehicle run: the vehicle's and the pedal's period reports into the brake functions and the barrier.
-void CcuApp::drain_vehicle(std::uint64_t k) {
+void CcuApp::drain_vehicle() {
   if (!brake_) return;
   while (vehicle_in_->take(vehicle_msg_)) {
     if (vehicle_msg_.run_id() != options_.participant.run_id) continue;
@@ -149,21 +149,8 @@ void CcuApp::drain_vehicle(std::uint64_t k) {
   }
   while (pedal_in_->take(pedal_msg_)) {
     if (pedal_msg_.run_id() != options_.participant.run_id) continue;
-    for (const msg::PedalSample& p : pedal_msg_.samples()) {
-      if (p.run_id() != options_.participant.run_id || p.step() != pedal_next_step_) {
-        ++pedal_rejected_;
-      } else if (pedal_ahead_.size() >= kPedalAheadMax) {
-        ++pedal_ahead_overflows_;
-      } else {
-        pedal_ahead_.push_back(p);
-        ++pedal_next_step_;
-      }
-    }
-  }
-  while (!pedal_ahead_.empty() && pedal_ahead_.front().step() <= k) {
-    brake_->on_pedal(pedal_ahead_.front());
-    node_.participant_done(pedal_participant_, pedal_ahead_.front().step());
-    pedal_ahead_.pop_front();
+    brake_->on_pedal(pedal_msg_);
+    node_.participant_done(pedal_participant_, pedal_msg_.step());
   }
 }
 
@@ -176,7 +163,7 @@ bool CcuApp::wait_for_corners(std::string& error) {
     for (std::size_t i = 0; i < node_.channels(); ++i) all = all && node_.channel(i).health >= 0 && blocks_[i]->peers() >= 1;
     if (brake_) {
       all = all && vehicle_in_->peers() >= 1 && pedal_in_->peers() >= 1;
-      // The pedal reads the front-left corner's commands until the first (its start).
+      // The pedal reads the front-left corner's commands (its grants).
       for (std::size_t i = 0; i < node_.channels(); ++i) {
         if (node_.channel(i).slot == 0) all = all && commands_[i]->peers() >= 2;
       }
@@ -454,7 +441,7 @@ int CcuApp::run(std::string& error) {
       // may have matched our writer only after it was sent.
       auto pred = [&] {
         drain_blocks(t_end, k);
-        drain_vehicle(k);
+        drain_vehicle();
         drain_health();
         drain_qos_events(t_end, true);
         return node_.period_complete(k);
@@ -563,10 +550,6 @@ int CcuApp::run(std::string& error) {
   wall_s_ = std::chrono::duration<double>(Clock::now() - t0_).count();
   sim_s_ = static_cast<double>(periods_done_) * T;
   write_failover_stats();
-  if (pedal_ahead_overflows_ > 0 || pedal_rejected_ > 0) {
-    std::cerr << "bbw_ccu (" << options_.role << "): pedal samples dropped: " << pedal_ahead_overflows_
-              << " more than " << kPedalAheadMax << " periods ahead, " << pedal_rejected_ << " out of order" << std::endl;
-  }
   if (stash_overflows_ > 0) {
     std::cerr << "bbw_ccu (" << options_.role << "): " << stash_overflows_
               << " blocks lost: this CCU fell more than 1024 periods behind the corners" << std::endl;
@@ -584,7 +567,7 @@ int CcuApp::run(std::string& error) {
 bool CcuApp::lockstep_period_complete(std::uint64_t k) {
   const double t_end = node_.period_end_s(k);
   drain_blocks(t_end, k);
-  drain_vehicle(k);
+  drain_vehicle();
   drain_health();
   drain_qos_events(t_end, true);
   if (!node_.period_complete(k)) return false;

@@ -10,7 +10,6 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
-#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -92,9 +91,7 @@ class CcuApp {
   void link_back();
   void write_failover_stats() const;
   double realtime_now_s() const;
-  // A vehicle run: the vehicle's and the pedal's readings up to period k into the brake functions
-  // and the barrier; the pedal's later samples wait in pedal_ahead_.
-  void drain_vehicle(std::uint64_t k);
+  void drain_vehicle();
   // Lockstep on the receiving thread (bbw/dds/receive_runner.hpp): the period whose blocks are
   // complete is ended where the last one arrives and the next one begun (plan, commands); true
   // when run()'s loop must carry on at next_k_ (a failure, the end).
@@ -150,18 +147,11 @@ class CcuApp {
   std::vector<std::pair<std::uint64_t, std::size_t>> restarts_;  // lockstep: (step, slot)
   // A vehicle run: the vehicle's and the pedal's readings, their barrier places, the brake functions.
   std::unique_ptr<dds::DdsInlet<msg::VehicleSensorsPubSubType>> vehicle_in_;
-  std::unique_ptr<dds::DdsInlet<msg::PedalSamplesPubSubType>> pedal_in_;
+  std::unique_ptr<dds::DdsInlet<msg::PedalSamplePubSubType>> pedal_in_;
   std::optional<vehicle_run::BrakeFunctions> brake_;
   std::size_t vehicle_participant_ = 0, pedal_participant_ = 0;
   msg::VehicleSensors vehicle_msg_;
-  msg::PedalSamples pedal_msg_;
-  // The pedal runs ahead of the barrier (vehicle_run::pedal_sample_allowed: at most
-  // kPedalLeadPeriods + N periods); its samples wait here in order, each for its own period.
-  static constexpr std::size_t kPedalAheadMax = 64;
-  std::deque<msg::PedalSample> pedal_ahead_;
-  std::uint64_t pedal_next_step_ = 0;        // the step the next pedal sample must have
-  std::uint64_t pedal_ahead_overflows_ = 0;  // samples beyond kPedalAheadMax, dropped
-  std::uint64_t pedal_rejected_ = 0;         // samples out of order (not the next step), dropped
+  msg::PedalSample pedal_msg_;
   // Lockstep on the receiving thread: the period whose blocks are awaited, whether its commands
   // were sent, and a corner's failure seen there.
   std::uint64_t next_k_ = 0;

@@ -59,12 +59,14 @@ Participant::Participant(const ParticipantOptions& options)
                                                  : fdds::Log::Kind::Error);
   }
   // Content filters need the TypeObjects, which are otherwise registered only when a message
-  // object is first constructed. Every process registers all of them before its participant
-  // exists: Fast DDS 2.9 builds a discovered writer's type from its TypeObject on a receive thread
-  // (PDP::check_and_notify_type_discovery) and adds identifiers it does not know to the process's
-  // TypeObjectFactory without a lock against the other threads doing the same; a sequence type
-  // not registered here (PedalSamples, in the corners) crashed a corner in 3 of 12 vehicle runs
-  // (TypeIdentifier::_d in TypeObjectFactory::get_sequence_identifier). Known, they are only looked up.
+  // object is first constructed. Every process registers all of them, the vehicle's too, before
+  // its participant exists: Fast DDS 2.9 builds a discovered writer's type from its TypeObject on a
+  // receive thread (PDP::check_and_notify_type_discovery) and adds the identifiers it does not
+  // know to the process's TypeObjectFactory, unguarded against the other threads doing the same.
+  // A sequence type a process had not registered (a pedal message tried on 2026-11-26, in the
+  // corners) crashed a corner in 3 of 12 vehicle runs (TypeIdentifier::_d under
+  // TypeObjectFactory::get_sequence_identifier); registered here, 0 of 20. Known, they are only
+  // looked up.
   registerbbw_msgsTypes();
   registerbbw_vehicle_msgsTypes();
   const std::string file = options.profiles_file.empty() ? default_profiles_file() : options.profiles_file;

@@ -3,7 +3,6 @@
 // its wheels from locking and stays in lane; bad scenarios are refused with file, line and key.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -243,28 +242,6 @@ TEST(VehicleRun, TheCornersTakeTheCaliperTemperatureEveryNPeriods) {
   EXPECT_EQ(vehicle_C.size(), 40 * kN + 2);
   EXPECT_GT(vehicle_C.back(), vehicle_C.front());  // the caliper did warm: each send was a change
   EXPECT_EQ(changes, 40u);  // after periods N - 1, 2N - 1, ..., 40N - 1
-}
-
-// bbw_pedal runs ahead of the barrier, paced by the vehicle's CaliperTemperatures
-// (vehicle_run::pedal_sample_allowed). Played out period by period as the processes would: the
-// vehicle ends period k once the pedal's sample k is out; the pedal never holds the vehicle up
-// (no deadlock, never the barrier's last), and never runs further ahead than the CCU keeps
-// (bbw_ccu's 64 samples; the lockstep reader's depth is 64 as well).
-TEST(VehicleRun, ThePedalRunsAheadOfTheVehicleWithinABound) {
-  constexpr std::uint64_t kN = msg::CALIPER_TEMPERATURE_EVERY_PERIODS;
-  EXPECT_TRUE(vehicle_run::pedal_sample_allowed(0, 0));  // the first samples need the first grant only
-  EXPECT_FALSE(vehicle_run::pedal_sample_allowed(vehicle_run::kPedalLeadPeriods, 0));
-  std::uint64_t pedal_sent = 0, vehicle_done = 0, paced_by = 0, max_ahead = 0;
-  for (std::uint64_t k = 0; k < 100 * kN; ++k) {
-    // The pedal sends all it may before the vehicle ends period k.
-    while (vehicle_run::pedal_sample_allowed(pedal_sent, paced_by)) ++pedal_sent;
-    ASSERT_GT(pedal_sent, k) << "the vehicle's period " << k << " would wait for the pedal";
-    max_ahead = std::max(max_ahead, pedal_sent - k);
-    vehicle_done = k + 1;
-    if (node::caliper_temperature_sent_after(k)) paced_by = vehicle_done;
-  }
-  EXPECT_GE(max_ahead, kN);  // ahead by more than a period: off the barrier's critical path
-  EXPECT_LE(max_ahead, 64u);
 }
 
 // UN R13-H Annex 6 Appendix 2's per-axle adhesion from simulated runs without anti-lock: a

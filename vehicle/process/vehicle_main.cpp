@@ -71,9 +71,9 @@ class VehicleApp {
 
   int run(std::string& error) {
     // Peers: every corner's block writer, our sensors' reader (the CCU) and our temperatures'
-    // readers (the four corners, and the pedal: its pace).
+    // readers (the four corners).
     const bool found = events_.wait_for(options_.discovery_timeout, [&] {
-      bool all = sensors_.peers() >= 1 && temperatures_.peers() >= 5;
+      bool all = sensors_.peers() >= 1 && temperatures_.peers() >= 4;
       for (const auto& b : blocks_) all = all && b->peers() >= 1;
       return all;
     });
@@ -81,7 +81,7 @@ class VehicleApp {
       if (events_.interrupted()) return kExitOk;
       error = "CCU and corners not discovered within " + std::to_string(options_.discovery_timeout.count()) +
               " ms (sensor readers matched " + std::to_string(sensors_.peers()) + " of 1, temperature readers " +
-              std::to_string(temperatures_.peers()) + " of 5)";
+              std::to_string(temperatures_.peers()) + " of 4)";
       return kExitDiscovery;
     }
     periods_ = node::periods_of(scenario_.corners.scenario);

@@ -12,7 +12,7 @@ inline constexpr const char* kHealthTopic = "bbw/CornerHealth";
 // A vehicle run (issue 15, idl/bbw_vehicle_msgs.idl): both in the run's partition, with the
 // measurement profiles (one sample per CCU period, the barrier's "period done").
 inline constexpr const char* kVehicleSensorsTopic = "bbw/VehicleSensors";
-inline constexpr const char* kPedalTopic = "bbw/PedalSamples";
+inline constexpr const char* kPedalTopic = "bbw/PedalSample";
 // The vehicle's caliper temperatures to the corners, every N periods (idl/bbw_vehicle_msgs.idl).
 inline constexpr const char* kCaliperTemperatureTopic = "bbw/CaliperTemperatures";
 

@@ -91,17 +91,6 @@ class VehicleNode {
   std::array<double, 4> lock_s_{}, longest_lock_s_{}, current_lock_s_{};
 };
 
-// bbw_pedal over DDS: the driver's pedal is open loop (its samples depend on the period only), so
-// after the CCU's first grant the pedal runs ahead of the barrier instead of waiting for a grant
-// every period. Its pace comes from the vehicle's CaliperTemperatures (every N-th period): sample k
-// may go out once the vehicle has ended period k - kPedalLeadPeriods or later (bbw_ccu keeps the
-// early samples and applies each at its own period). The lead is two temperature intervals, so the
-// pedal is never what the barrier waits for, and less than the 64 samples a lockstep reader keeps.
-inline constexpr std::uint64_t kPedalLeadPeriods = 2 * msg::CALIPER_TEMPERATURE_EVERY_PERIODS;
-// `vehicle_done`: the number of periods the vehicle has ended as far as the pedal knows (the newest
-// CaliperTemperatures step + 1; 0 before the first).
-inline bool pedal_sample_allowed(std::uint64_t k, std::uint64_t vehicle_done) { return k < vehicle_done + kPedalLeadPeriods; }
-
 class PedalNode {
  public:
   explicit PedalNode(const VehicleScenario& scenario);
