@@ -1,7 +1,8 @@
 // Vehicle runs over Fast DDS (issue 15, docs/vehicle.md): bbw_launch starts the processes a
 // vehicle scenario declares (bbw_ccu, four bbw_corner, bbw_vehicle, bbw_pedal) in lockstep; the
 // vehicle's truth and the CCU's and corners' logs equal the in-process run's (bbw_vehicle_inproc)
-// byte for byte, and summary.json carries the `vehicle` object. Domains 70-71.
+// byte for byte, and summary.json carries the `vehicle` object; so do they with a corner's process
+// killed in ABS braking. Domains 70-72.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -50,6 +51,71 @@ TEST(SystemVehicleRun, DryStopOverDdsEqualsTheInProcessRun) {
   EXPECT_NE(summary.find("\"vehicle\":"), std::string::npos);
   EXPECT_NE(summary.find("\"stopping_distance_m\":"), std::string::npos);
   EXPECT_NE(summary.find("\"scenario\": \"dry_straight_100kmh\""), std::string::npos) << summary.substr(0, 300);
+  std::filesystem::remove_all(dir);
+}
+
+// Domain 72. The shipped lost-corner scenario (FL's process killed 0.8 s in, 0.5 s into ABS
+// braking) over Fast DDS: the CCU and the vehicle learn the loss from the corner's writers' lost
+// liveliness while they wait for its period in lockstep, the vehicle's e-caliper releases, and
+// the run is the in-process one byte for byte.
+TEST(SystemVehicleRun, ALostCornerOverDdsEqualsTheInProcessRun) {
+  const std::string dir = scratch("vehicle", "lost_dds");
+  const std::string scenario = src("config/scenarios/vehicle/dry_fault_FL_lost_abs.yaml");
+  const ProcessRun dds = run("bbw_launch",
+                             {bin("bbw_launch"), scenario, "--out", dir + "/dds", "--domain", "72", "--discovery-timeout",
+                              "20", "--no-report"},
+                             dir, 150s);
+  ASSERT_TRUE(dds.status.ok()) << dds.status.describe() << "\n" << dds.out << dds.err;
+  EXPECT_NE(dds.out.find("killed bbw_corner FL as scheduled at 0.8 s"), std::string::npos) << dds.out;
+  const ProcessRun mem = run("bbw_vehicle_inproc", {bin("bbw_vehicle_inproc"), scenario, "--out", dir + "/mem", "--no-plots"},
+                             dir, 120s);
+  ASSERT_TRUE(mem.status.ok()) << mem.status.describe() << "\n" << mem.out << mem.err;
+  const std::string truth_dds = slurp(dir + "/dds/vehicle_truth.csv");
+  ASSERT_GT(truth_dds.size(), 100000u);  // 1400 periods
+  EXPECT_TRUE(truth_dds == slurp(dir + "/mem/vehicle_truth.csv")) << "the DDS run's vehicle differs from the in-process run's";
+  for (const char* log : {"ccu_FL.csv", "ccu_FR.csv", "ccu_periods.csv", "corner_RR_periods.csv"}) {
+    const std::string d = slurp(dir + "/dds/" + log);
+    EXPECT_FALSE(d.empty()) << log;
+    EXPECT_TRUE(d == slurp(dir + "/mem/" + log)) << log << " differs between Fast DDS and in process";
+  }
+  // The CCU took FL out of use: its last logged sample is at the kill, the periods run to the end.
+  const std::string fl = slurp(dir + "/dds/ccu_FL.csv");
+  const std::string last = fl.substr(fl.rfind('\n', fl.size() - 2) + 1);
+  EXPECT_LT(std::stod(last.substr(0, last.find(','))), 0.81) << last;
+  EXPECT_NE(slurp(dir + "/dds/vehicle.out").find("1400 periods"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// No DDS traffic: a restarted corner has no lockstep rejoin with the vehicle, so a vehicle
+// scenario's process faults are kills only; the launcher refuses a restart before starting anything.
+TEST(SystemVehicleRun, LauncherRefusesARestartInAVehicleScenario) {
+  const std::string dir = scratch("vehicle", "restart");
+  std::filesystem::create_directories(dir);
+  // The lost-corner calipers with a restart after the kill, and the scenario pointing at them
+  // (every relative path made absolute into the tree).
+  std::string corners = slurp(src("config/scenarios/vehicle/corners/calipers_FL_lost.yaml"));
+  const std::string kill = "  - {at_s: 0.8, corner: FL, part: process, type: kill}";
+  ASSERT_NE(corners.find(kill), std::string::npos);
+  corners.insert(corners.find(kill) + kill.size(), "\n  - {at_s: 2.0, corner: FL, part: process, type: restart}");
+  const std::string plant = "\nplant: ../../../plant/ecaliper.yaml";
+  ASSERT_NE(corners.find(plant), std::string::npos);
+  corners.replace(corners.find(plant), plant.size(), "\nplant: " + src("config/plant/ecaliper.yaml"));
+  std::ofstream(dir + "/calipers_restart.yaml") << corners;
+  std::string text = slurp(src("config/scenarios/vehicle/dry_fault_FL_lost_abs.yaml"));
+  const std::string corners_key = "\ncorners: corners/calipers_FL_lost.yaml";
+  ASSERT_NE(text.find(corners_key), std::string::npos);
+  text.replace(text.find(corners_key), corners_key.size(), "\ncorners: " + dir + "/calipers_restart.yaml");
+  for (const std::string key : {"vehicle: ", "brake_control: "}) {
+    const auto p = text.find("\n" + key) + 1;
+    text.insert(p + key.size(), src("config/scenarios/vehicle") + "/");
+  }
+  const std::string file = dir + "/restart.yaml";
+  std::ofstream(file) << text;
+  const ProcessRun r = run("bbw_launch", {bin("bbw_launch"), file, "--out", dir + "/out", "--domain", "72"}, dir, 30s);
+  EXPECT_TRUE(r.status.exited && r.status.code == 2) << r.status.describe() << "\n" << r.out << r.err;
+  // The calipers' file, its line and key, and the rule (a vehicle scenario's process faults are kills).
+  EXPECT_NE(r.err.find("calipers_restart.yaml:29: key 'faults[1].type': must be one of {kill}"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out/summary.json"));
   std::filesystem::remove_all(dir);
 }
 

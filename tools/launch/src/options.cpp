@@ -63,8 +63,17 @@ LoadedRun load_run(const Options& o) {
     r.scenario = std::move(vs.corners.scenario);
     r.scenario.name = vs.name;  // the run is the vehicle scenario's (its calipers' file is a part)
     r.schedule = std::move(vs.corners.faults);
-    if (!faults::process_actions(r.schedule).empty()) {
-      throw std::invalid_argument(o.scenario_file + ": process faults in a vehicle scenario run in process only (bbw_vehicle_inproc)");
+    // A corner's process killed for good: the CCU and the vehicle learn it from its writers' lost
+    // liveliness while they wait for its period in lockstep, so the run is the in-process one
+    // (SystemVehicleRun.ALostCornerOverDdsEqualsTheInProcessRun). A restart, a hang or a CCU fault
+    // has no lockstep rejoin with the vehicle and pedal (the vehicle scenario's loader takes kills
+    // only; checked here too, as the launcher's own rule).
+    for (const faults::ProcessAction& a : faults::process_actions(r.schedule)) {
+      if (a.kind != faults::ProcessAction::Kind::Kill || faults::is_ccu(a.target)) {
+        throw std::invalid_argument(o.scenario_file +
+                                    ": over Fast DDS a vehicle scenario takes only a corner process killed for good "
+                                    "(no restart, hang or CCU fault); run this one in process (bbw_vehicle_inproc)");
+      }
     }
     r.processes = vs.processes;
   } else {
