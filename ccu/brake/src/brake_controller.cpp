@@ -38,6 +38,9 @@ void BrakeControlParams::validate() const {
   require(slip.caliper_release_kN >= 0 && slip.caliper_gap_s > 0 && slip.caliper_retract_s > 0 && slip.caliper_rate_kN_s > 0 &&
               slip.caliper_lag_s > 0 && slip.release_freeze_margin_Nm >= 0,
           "slip: caliper_release_kN, release_freeze_margin_Nm >= 0; caliper_gap_s, caliper_retract_s, caliper_rate_kN_s, caliper_lag_s > 0");
+  require(car.drag_N_s2_per_m2 >= 0 && car.rolling_resistance >= 0 && mass.min_decel_g > 0 && mass.time_constant_s > 0 &&
+              mass.max_factor >= 1 && mass.deadband >= 0,
+          "car: drag and rolling resistance >= 0; mass_estimate: min_decel_g, time_constant_s > 0, max_factor >= 1, deadband >= 0");
 }
 
 PedalDemand pedal_demand(const PedalDemandParams& p, double travel_mm, double force_N) {
@@ -116,12 +119,26 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
   ax_filt_ += std::min(1.0, dt_s / 0.03) * (m.ax_m_s2 - ax_filt_);
   const double z_meas = std::clamp(-ax_filt_ / kG, 0.0, z_request);
   const double L = c.cg_to_front_axle_m + c.cg_to_rear_axle_m;
-  const double total_N = c.mass_kg * kG * z_request;
+  // The car's mass from its own braking (a laden car): while no wheel is under slip control (the
+  // tyres carry what the brakes apply), the tyres' braking forces (the slip controllers' last
+  // R Fx = T + I dw/dt, through the loads they were given) and the driving resistance over the
+  // measured deceleration.
+  if (mass_kg_ <= 0.0) mass_kg_ = c.mass_kg;
+  if (p_.mass.enabled && !any_active && z_request > 0.0 && -ax_filt_ > p_.mass.min_decel_g * kG && v > p_.slip.min_speed_m_s) {
+    double fx_N = 0.0;
+    for (std::size_t w = 0; w < 4; ++w) fx_N += m.available[w] ? slip_[w].last().mu_estimate * load_in_N_[w] : 0.0;
+    const double resistance_N = c.drag_N_s2_per_m2 * v * v + c.rolling_resistance * mass_kg_ * kG;
+    const double raw_kg = std::clamp((fx_N + resistance_N) / -ax_filt_, c.mass_kg, p_.mass.max_factor * c.mass_kg);
+    mass_kg_ += std::min(1.0, dt_s / p_.mass.time_constant_s) * (raw_kg - mass_kg_);
+  }
+  mass_used_kg_ = std::max(c.mass_kg, mass_kg_ - p_.mass.deadband * c.mass_kg);
+  const double mass = mass_used_kg_;
+  const double total_N = mass * kG * z_request;
   const double front_share = std::clamp((c.cg_to_rear_axle_m + c.cg_height_m * z_meas) / L, 0.3, 0.9);
-  const double front_axle_load = c.mass_kg * kG * (c.cg_to_rear_axle_m + c.cg_height_m * z_meas) / L;
-  const double rear_axle_load = c.mass_kg * kG - front_axle_load;
+  const double front_axle_load = mass * kG * (c.cg_to_rear_axle_m + c.cg_height_m * z_meas) / L;
+  const double rear_axle_load = mass * kG - front_axle_load;
   // Lateral transfer from the IMU (ay > 0: left turn loads the right wheels).
-  const double roll = c.mass_kg * m.ay_m_s2 * c.cg_height_m;
+  const double roll = mass * m.ay_m_s2 * c.cg_height_m;
   const std::array<double, 4> load{0.5 * front_axle_load - 0.55 * roll / c.track_front_m,
                                    0.5 * front_axle_load + 0.55 * roll / c.track_front_m,
                                    0.5 * rear_axle_load - 0.45 * roll / c.track_rear_m,
@@ -149,6 +166,7 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
     in.request_Nm = request[w];
     in.applied_Nm = torque_Nm(w, std::max(0.0, m.clamp_estimate_kN[w]));
     in.load_N = std::max(100.0, load[w]);
+    load_in_N_[w] = in.load_N;
     if (!p_.abs_enabled) {
       out_.wheels[w] = WheelDecision{};
       out_.wheels[w].torque_Nm = in.request_Nm;

@@ -25,6 +25,17 @@ BrakeControlParams read_brake_control(Reader& r) {
     p.car.rear_effective_radius_m = c.number("rear_effective_radius_m", Range::closed(0.03, 0.3));
     p.car.max_clamp_force_kN = c.number("max_clamp_force_kN", Range::closed(1, 100));
     p.car.understeer_gradient_rad_s2_per_m = c.number("understeer_gradient_rad_s2_per_m", Range::closed(-0.01, 0.01));
+    p.car.drag_N_s2_per_m2 = c.number("drag_N_s2_per_m2", Range::closed(0, 10));
+    p.car.rolling_resistance = c.number("rolling_resistance", Range::closed(0, 0.1));
+    c.finish();
+  }
+  {
+    Reader c = r.map("mass_estimate");
+    p.mass.enabled = c.boolean("enabled");
+    p.mass.min_decel_g = c.number("min_decel_g", Range::closed(0.05, 1));
+    p.mass.time_constant_s = c.number("time_constant_s", Range::positive());
+    p.mass.max_factor = c.number("max_factor", Range::closed(1, 3));
+    p.mass.deadband = c.number("deadband", Range::closed(0, 1));
     c.finish();
   }
   {

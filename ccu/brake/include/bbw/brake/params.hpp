@@ -21,6 +21,20 @@ struct CarModel {
   // Understeer gradient of the linear single-track model (rad per m/s^2 of lateral acceleration):
   // the driver's yaw rate is v delta / (L + K_us v^2).
   double understeer_gradient_rad_s2_per_m = 1.6e-4;
+  // Driving resistance for the mass estimate: aerodynamic drag (1/2 rho Cd A, N per (m/s)^2) and
+  // the rolling-resistance coefficient.
+  double drag_N_s2_per_m2 = 0.396;
+  double rolling_resistance = 0.013;
+};
+
+// The car's mass from its own braking (docs/vehicle.md, "A population of cars"): a laden car
+// needs more braking force for the same deceleration than the nominal model's mass asks for.
+struct MassEstimateParams {
+  bool enabled = true;
+  double min_decel_g = 0.2;       // estimated only while the car decelerates at least this
+  double time_constant_s = 0.1;   // low-pass of the raw estimate
+  double max_factor = 1.5;        // the estimate within [nominal, this x nominal]
+  double deadband = 0.1;          // used less this x nominal (its bias on light cars), never below nominal
 };
 
 struct PedalDemandParams {
@@ -148,6 +162,7 @@ struct BrakeControlParams {
   SpeedEstimatorParams speed;
   SlipControlParams slip;
   YawLimitParams yaw;
+  MassEstimateParams mass;
   bool abs_enabled = true;
 
   void validate() const;  // throws std::invalid_argument
