@@ -119,6 +119,40 @@ TEST(SystemVehicleRun, LauncherRefusesARestartInAVehicleScenario) {
   std::filesystem::remove_all(dir);
 }
 
+// scripts/vehicle-population.py (docs/vehicle.md, eleventh part), a small subset: four drawn
+// laden cars, one per surface, run in process; the table names every draw and each surface's
+// worst; population.json holds the drawn cars and their figures; the same seed draws the same
+// cars; a second call resumes (runs nothing again: the same figures). No DDS.
+TEST(SystemVehicleRun, APopulationOfLadenCarsIsDrawnRunAndResumed) {
+  const std::string dir = scratch("vehicle", "population");
+  const std::vector<std::string> argv{"/usr/bin/python3", src("scripts/vehicle-population.py"), dir + "/pop", "--draws", "4",
+                                      "--seed", "7", "--jobs", "2"};
+  const std::vector<std::string> env{"BBW_BUILD_DIR=" + std::string(BBW_TEST_BINARY_DIR)};
+  const ProcessRun first = run("population", argv, dir, 300s, env);
+  ASSERT_TRUE(first.status.ok()) << first.status.describe() << "\n" << first.out << first.err;
+  for (const char* draw : {"vp_000_dry", "vp_001_wet", "vp_002_snow", "vp_003_ice"}) {
+    EXPECT_NE(first.out.find("| " + std::string(draw) + " |"), std::string::npos) << draw << "\n" << first.out;
+    EXPECT_TRUE(std::filesystem::exists(dir + "/pop/runs/" + draw + "/summary.json")) << draw;
+  }
+  EXPECT_NE(first.out.find("| ice | 1 (0 not stopped) |"), std::string::npos) << first.out;
+  EXPECT_NE(first.err.find("4/4 stops"), std::string::npos) << first.err;  // progress
+  const std::string json = slurp(dir + "/pop/population.json");
+  EXPECT_NE(json.find("\"payload_kg\""), std::string::npos);
+  EXPECT_NE(json.find("\"distance_ratio\""), std::string::npos);
+  // Resumed: nothing is run again, the same table comes out.
+  const auto stamp = std::filesystem::last_write_time(dir + "/pop/runs/vp_000_dry/summary.json");
+  const ProcessRun again = run("population_again", argv, dir, 120s, env);
+  ASSERT_TRUE(again.status.ok()) << again.status.describe() << "\n" << again.err;
+  EXPECT_EQ(again.out, first.out);
+  EXPECT_TRUE(std::filesystem::last_write_time(dir + "/pop/runs/vp_000_dry/summary.json") == stamp);
+  // Bad input: a clear error and a non-zero exit.
+  const ProcessRun bad = run("population_bad", {"/usr/bin/python3", src("scripts/vehicle-population.py"), dir + "/bad", "--draws", "0"},
+                             dir, 60s, env);
+  EXPECT_TRUE(bad.status.exited && bad.status.code != 0) << bad.status.describe();
+  EXPECT_NE(bad.err.find("--draws and --jobs must be at least 1"), std::string::npos) << bad.err;
+  std::filesystem::remove_all(dir);
+}
+
 // No DDS traffic: the launcher refuses before starting anything.
 TEST(SystemVehicleRun, LauncherRefusesAVehicleScenarioInRealtime) {
   const std::string dir = scratch("vehicle", "realtime");
