@@ -13,6 +13,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iostream>
 #include <map>
 #include <optional>
 #include <tuple>
@@ -47,6 +49,33 @@ std::vector<std::string> launch_argv(const std::string& scenario, const std::str
 }
 
 std::string describe(const bbw::runtime::ExitStatus& st, Launch& l) { return st.describe() + "\n" + l.out() + l.err(); }
+
+// Two launches at once on one domain (outputs DIR/a and DIR/b), run again - at most twice - only
+// when one failed of Fast DDS 2.9's discovery assertion (`fastdds_pdp_abort`, docs/faults.md: a
+// race inside Fast DDS that a domain shared by two runs' participants coming and going meets),
+// saying so; any other failure is judged. `before_each` clears what an attempt leaves behind.
+struct TwoRuns {
+  std::unique_ptr<Launch> a, b;
+  bbw::runtime::ExitStatus sa, sb;
+};
+TwoRuns two_runs_at_once(const std::string& dir, const std::function<std::vector<std::string>(const std::string&)>& argv_of,
+                         const std::vector<std::string>& env, std::chrono::seconds limit,
+                         const std::function<void()>& before_each = {}) {
+  TwoRuns r;
+  for (int attempt = 1;; ++attempt) {
+    if (before_each) before_each();
+    fs::remove_all(dir + "/a");
+    fs::remove_all(dir + "/b");
+    r.a = std::make_unique<Launch>(dir, "a", argv_of(dir + "/a"), env);
+    r.b = std::make_unique<Launch>(dir, "b", argv_of(dir + "/b"), env);
+    r.sa = r.a->wait(limit);
+    r.sb = r.b->wait(limit);
+    std::string aborted = r.sa.ok() ? "" : fastdds_pdp_abort(dir + "/a");
+    if (aborted.empty() && !r.sb.ok()) aborted = fastdds_pdp_abort(dir + "/b");
+    if (aborted.empty() || attempt == 3) return r;
+    std::cout << "NOTE: attempt " << attempt << " not judged: the Fast DDS 2.9 discovery assertion in " << aborted << "\n";
+  }
+}
 
 // Children of `pid` (from /proc), by their command name (comm).
 std::map<std::string, pid_t> children_of(pid_t pid) {
@@ -125,12 +154,11 @@ TEST(SystemIsolation, TwoLockstepRunsOnOneDomainEachEqualTheSoloRun) {
     const auto st = solo.wait(150s);
     ASSERT_TRUE(st.ok()) << describe(st, solo);
   }
-  Launch a(dir, "a", launch_argv(scenario, dir + "/a", "lockstep", 201));
-  Launch b(dir, "b", launch_argv(scenario, dir + "/b", "lockstep", 201));
-  const auto sa = a.wait(150s);
-  const auto sb = b.wait(150s);
-  ASSERT_TRUE(sa.ok()) << describe(sa, a);
-  ASSERT_TRUE(sb.ok()) << describe(sb, b);
+  TwoRuns runs = two_runs_at_once(
+      dir, [&](const std::string& out) { return launch_argv(scenario, out, "lockstep", 201); }, {}, 150s);
+  Launch &a = *runs.a, &b = *runs.b;
+  ASSERT_TRUE(runs.sa.ok()) << describe(runs.sa, a);
+  ASSERT_TRUE(runs.sb.ok()) << describe(runs.sb, b);
   expect_same_logs(dir + "/solo", dir + "/a", "run a");
   expect_same_logs(dir + "/solo", dir + "/b", "run b");
   const std::string ja = slurp(dir + "/a/summary.json"), jb = slurp(dir + "/b/summary.json");
@@ -166,12 +194,12 @@ TEST(SystemIsolation, TwoSecureRunsOnOneDomainEachEqualTheSoloRun) {
   // waits on the keys directory's lock.
   ASSERT_FALSE(fs::exists(dir + "/keys"));
   const std::vector<std::string> secure{"--secure", "--keys", dir + "/keys"};
-  Launch a(dir, "a", launch_argv(scenario, dir + "/a", "lockstep", 202, secure), env);
-  Launch b(dir, "b", launch_argv(scenario, dir + "/b", "lockstep", 202, secure), env);
-  const auto sa = a.wait(200s);
-  const auto sb = b.wait(200s);
-  ASSERT_TRUE(sa.ok()) << describe(sa, a);
-  ASSERT_TRUE(sb.ok()) << describe(sb, b);
+  TwoRuns runs = two_runs_at_once(
+      dir, [&](const std::string& out) { return launch_argv(scenario, out, "lockstep", 202, secure); }, env, 200s,
+      [&] { fs::remove_all(dir + "/keys"); });  // each attempt starts without keys
+  Launch &a = *runs.a, &b = *runs.b;
+  ASSERT_TRUE(runs.sa.ok()) << describe(runs.sa, a);
+  ASSERT_TRUE(runs.sb.ok()) << describe(runs.sb, b);
   EXPECT_NE((a.out() + b.out()).find("creating DDS Security keys"), std::string::npos);
   EXPECT_TRUE(a.out().find("creating DDS Security keys") == std::string::npos ||
               b.out().find("creating DDS Security keys") == std::string::npos)
