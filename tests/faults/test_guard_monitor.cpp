@@ -821,6 +821,41 @@ TEST(FaultMonitor, BeforeAFitTheEndOfLineFrictionModelAndTheHoldRuleFindADrift) 
   EXPECT_LT(d.detected_s, 4.5);
 }
 
+// The hold rule's reference belongs to one way of computing the residual (extreme population,
+// 2026-11-26, run 75: a healthy stiff caliper named load_cell_offset). A slow apply (0.3 rev/s,
+// a hold to the rule) that begins a few samples before the end-of-line friction model's state
+// becomes known: the residual drops by the whole friction (about 1.5 kN) at that moment. Before
+// the fix the reference then completed as the mean of samples from both sides of the drop and
+// the hold rule took the drop for a 1.1-1.5 kN change; now the change of definition restarts the
+// settling too, and nothing is raised, whichever sample the drop falls on.
+TEST(FaultMonitor, TheHoldRuleRestartsWhenTheFrictionModelComesInWhileItSettles) {
+  MonitorParams p = eol_params(1.5, false);
+  p.hold_span_rev = 10.0;  // no restart by distance: only the definition's change matters here
+  const double sweep_rev = 2.0 * bbw::plant::KeyFriction{*p.eol_key_friction}.thresholds_rev().back();
+  const double x0 = 2.0, slow = 0.3, fast = 1.0;
+  int findings = 0;
+  for (int before : {2, 6, 10, 14, 18}) {  // settling samples before the friction model comes in
+    EolCaliper caliper{p};
+    auto& [eol, keys, T] = caliper;
+    FaultMonitor m(p, Target::FL);
+    SampleGuard g{MonitorParams{}.guard};
+    const double x_slow = x0 + sweep_rev - (before + 0.5) * slow * 0.001;  // where the slow part begins
+    double x = x0;
+    for (int n = 1; n < 4000; ++n) {
+      const double t = 0.001 * n;
+      const double speed = x < x_slow ? fast : slow;
+      x += speed * 0.001;
+      const double lc = eol.force_kN(x, T, 0.0) + keys.step(x) + 0.03 * ((n % 5) - 2);
+      const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
+      const auto e = uncalibrated(lc);
+      m.update(r, g.check(r), &e, lc, t);
+    }
+    EXPECT_FALSE(m.diagnosis(Part::LoadCell).present) << before << " settling samples before the friction model came in";
+    findings += m.diagnosis(Part::LoadCell).present ? 1 : 0;
+  }
+  EXPECT_EQ(findings, 0);
+}
+
 // The noise rule reads the raw load cell against the curve at the position (issue 14): an
 // estimate that is filtered (as the CCU's is) does not hide a 0.35 kN RMS burst in a held stop.
 TEST(FaultMonitor, ANoiseBurstIsFoundInTheRawLoadCellNotTheFilteredEstimate) {

@@ -185,9 +185,13 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   const bool slow = hold_mode && std::abs(r.speed_rev_per_s) < p.hold_speed_rev_per_s && std::isfinite(residual_kN_);
   // The reference belongs to one way of computing the residual: the friction model's state
   // becoming known moves the residual by the whole friction (a fault-free finding at 1.02 s,
-  // scoring run 1599, before this).
-  if (!slow || (hold_ref_ && (std::abs(x_hold - hold_x0_rev_) > p.hold_span_rev || hold_eol_mode_ != eol_here ||
-                              hold_known_ != friction_known_))) {
+  // scoring run 1599, before this). So a change of definition (the end-of-line curve here or not,
+  // the friction model's state known) restarts the hold, also while it is still settling: a
+  // reference averaged across the change is neither level (extreme population run 75: 19 samples
+  // before the friction model came in, one after, a 1.1 kN "change" on a healthy caliper).
+  const bool settling_or_set = hold_ref_ || hold_slow_ > 0;
+  if (!slow || (settling_or_set && (hold_eol_mode_ != eol_here || hold_known_ != friction_known_)) ||
+      (hold_ref_ && std::abs(x_hold - hold_x0_rev_) > p.hold_span_rev)) {
     hold_ref_ = false;
     hold_slow_ = 0;
     hold_sum_kN_ = 0.0;
@@ -195,6 +199,10 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   bool hold_over = false;
   hold_change_kN_ = std::numeric_limits<double>::quiet_NaN();
   if (slow && !hold_ref_) {
+    if (hold_slow_ == 0) {  // the definition the reference is averaged under
+      hold_eol_mode_ = eol_here;
+      hold_known_ = friction_known_;
+    }
     ++hold_slow_;
     hold_sum_kN_ += residual_kN_;
     if (hold_slow_ >= p.hold_settle_samples) {
