@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 #include <string>
 
@@ -24,27 +25,38 @@ std::string slurp(const std::string& file) {
   return ss.str();
 }
 
-// Domain 70.
-TEST(SystemVehicleRun, DryStopOverDdsEqualsTheInProcessRun) {
-  const std::string dir = scratch("vehicle", "dry_dds");
-  const std::string scenario = src("config/scenarios/vehicle/dry_straight_100kmh.yaml");
+// One vehicle scenario over Fast DDS (DIR/dds, on `domain`) and in process (DIR/mem); asserts
+// both ran, that the DDS run's vehicle truth (1400 periods at least) and `logs` equal the
+// in-process run's byte for byte, and returns the launcher's run.
+ProcessRun dds_equals_in_process(const std::string& dir, const std::string& scenario, int domain,
+                                 std::initializer_list<const char*> logs) {
   const ProcessRun dds = run("bbw_launch",
-                             {bin("bbw_launch"), scenario, "--out", dir + "/dds", "--domain", "70", "--discovery-timeout",
-                              "20", "--no-report"},
+                             {bin("bbw_launch"), scenario, "--out", dir + "/dds", "--domain", std::to_string(domain),
+                              "--discovery-timeout", "20", "--no-report"},
                              dir, 150s);
-  ASSERT_TRUE(dds.status.ok()) << dds.status.describe() << "\n" << dds.out << dds.err;
+  EXPECT_TRUE(dds.status.ok()) << dds.status.describe() << "\n" << dds.out << dds.err;
   const ProcessRun mem = run("bbw_vehicle_inproc", {bin("bbw_vehicle_inproc"), scenario, "--out", dir + "/mem", "--no-plots"},
                              dir, 120s);
-  ASSERT_TRUE(mem.status.ok()) << mem.status.describe() << "\n" << mem.out << mem.err;
+  EXPECT_TRUE(mem.status.ok()) << mem.status.describe() << "\n" << mem.out << mem.err;
   const std::string truth_dds = slurp(dir + "/dds/vehicle_truth.csv");
-  ASSERT_GT(truth_dds.size(), 100000u);  // 1400 periods
+  EXPECT_GT(truth_dds.size(), 100000u);  // 1400 periods
   EXPECT_TRUE(truth_dds == slurp(dir + "/mem/vehicle_truth.csv")) << "the DDS run's vehicle differs from the in-process run's";
-  // The CCU's and the corners' logs too (the same node cores, the same lockstep protocol).
-  for (const char* log : {"ccu_FL.csv", "ccu_RR.csv", "ccu_periods.csv", "corner_FL_periods.csv", "corner_RR_periods.csv"}) {
+  for (const char* log : logs) {
     const std::string d = slurp(dir + "/dds/" + log);
     EXPECT_FALSE(d.empty()) << log;
     EXPECT_TRUE(d == slurp(dir + "/mem/" + log)) << log << " differs between Fast DDS and in process";
   }
+  return dds;
+}
+
+// Domain 70.
+TEST(SystemVehicleRun, DryStopOverDdsEqualsTheInProcessRun) {
+  const std::string dir = scratch("vehicle", "dry_dds");
+  // The CCU's and the corners' logs too (the same node cores, the same lockstep protocol).
+  const ProcessRun dds = dds_equals_in_process(dir, src("config/scenarios/vehicle/dry_straight_100kmh.yaml"), 70,
+                                               {"ccu_FL.csv", "ccu_RR.csv", "ccu_periods.csv", "corner_FL_periods.csv",
+                                                "corner_RR_periods.csv"});
+  if (HasFailure()) return;
   EXPECT_NE(slurp(dir + "/dds/vehicle.out").find("1400 periods"), std::string::npos);
   EXPECT_NE(slurp(dir + "/dds/pedal.out").find("1400 periods"), std::string::npos);
   const std::string summary = slurp(dir + "/dds/summary.json");
@@ -60,24 +72,10 @@ TEST(SystemVehicleRun, DryStopOverDdsEqualsTheInProcessRun) {
 // the run is the in-process one byte for byte.
 TEST(SystemVehicleRun, ALostCornerOverDdsEqualsTheInProcessRun) {
   const std::string dir = scratch("vehicle", "lost_dds");
-  const std::string scenario = src("config/scenarios/vehicle/dry_fault_FL_lost_abs.yaml");
-  const ProcessRun dds = run("bbw_launch",
-                             {bin("bbw_launch"), scenario, "--out", dir + "/dds", "--domain", "72", "--discovery-timeout",
-                              "20", "--no-report"},
-                             dir, 150s);
-  ASSERT_TRUE(dds.status.ok()) << dds.status.describe() << "\n" << dds.out << dds.err;
+  const ProcessRun dds = dds_equals_in_process(dir, src("config/scenarios/vehicle/dry_fault_FL_lost_abs.yaml"), 72,
+                                               {"ccu_FL.csv", "ccu_FR.csv", "ccu_periods.csv", "corner_RR_periods.csv"});
+  if (HasFailure()) return;
   EXPECT_NE(dds.out.find("killed bbw_corner FL as scheduled at 0.8 s"), std::string::npos) << dds.out;
-  const ProcessRun mem = run("bbw_vehicle_inproc", {bin("bbw_vehicle_inproc"), scenario, "--out", dir + "/mem", "--no-plots"},
-                             dir, 120s);
-  ASSERT_TRUE(mem.status.ok()) << mem.status.describe() << "\n" << mem.out << mem.err;
-  const std::string truth_dds = slurp(dir + "/dds/vehicle_truth.csv");
-  ASSERT_GT(truth_dds.size(), 100000u);  // 1400 periods
-  EXPECT_TRUE(truth_dds == slurp(dir + "/mem/vehicle_truth.csv")) << "the DDS run's vehicle differs from the in-process run's";
-  for (const char* log : {"ccu_FL.csv", "ccu_FR.csv", "ccu_periods.csv", "corner_RR_periods.csv"}) {
-    const std::string d = slurp(dir + "/dds/" + log);
-    EXPECT_FALSE(d.empty()) << log;
-    EXPECT_TRUE(d == slurp(dir + "/mem/" + log)) << log << " differs between Fast DDS and in process";
-  }
   // The CCU took FL out of use: its last logged sample is at the kill, the periods run to the end.
   const std::string fl = slurp(dir + "/dds/ccu_FL.csv");
   const std::string last = fl.substr(fl.rfind('\n', fl.size() - 2) + 1);
