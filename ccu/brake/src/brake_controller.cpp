@@ -61,8 +61,13 @@ BrakeController::BrakeController(const BrakeControlParams& p)
       slip_{SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2, 2000.0 * p.car.pad_mu * p.car.front_effective_radius_m),
             SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2, 2000.0 * p.car.pad_mu * p.car.front_effective_radius_m),
             SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2, 2000.0 * p.car.pad_mu * p.car.rear_effective_radius_m),
-            SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2, 2000.0 * p.car.pad_mu * p.car.rear_effective_radius_m)} {
+            SlipController(p.slip, p.car.wheel_radius_m, p.car.wheel_inertia_kg_m2, 2000.0 * p.car.pad_mu * p.car.rear_effective_radius_m)},
+      mass_kg_(p.car.mass_kg) {
   p_.validate();
+}
+
+double BrakeController::mass_used_kg() const {
+  return std::max(p_.car.mass_kg, mass_kg_ - p_.mass.deadband * p_.car.mass_kg);
 }
 
 double BrakeController::clamp_kN(std::size_t w, double torque) const {
@@ -123,7 +128,6 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
   // tyres carry what the brakes apply), the tyres' braking forces (the slip controllers' last
   // R Fx = T + I dw/dt, through the loads they were given) and the driving resistance over the
   // measured deceleration.
-  if (mass_kg_ <= 0.0) mass_kg_ = c.mass_kg;
   if (p_.mass.enabled && !any_active && z_request > 0.0 && -ax_filt_ > p_.mass.min_decel_g * kG && v > p_.slip.min_speed_m_s) {
     double fx_N = 0.0;
     for (std::size_t w = 0; w < 4; ++w) fx_N += m.available[w] ? slip_[w].last().mu_estimate * load_in_N_[w] : 0.0;
@@ -131,8 +135,7 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
     const double raw_kg = std::clamp((fx_N + resistance_N) / -ax_filt_, c.mass_kg, p_.mass.max_factor * c.mass_kg);
     mass_kg_ += std::min(1.0, dt_s / p_.mass.time_constant_s) * (raw_kg - mass_kg_);
   }
-  mass_used_kg_ = std::max(c.mass_kg, mass_kg_ - p_.mass.deadband * c.mass_kg);
-  const double mass = mass_used_kg_;
+  const double mass = mass_used_kg();
   const double total_N = mass * kG * z_request;
   const double front_share = std::clamp((c.cg_to_rear_axle_m + c.cg_height_m * z_meas) / L, 0.3, 0.9);
   const double front_axle_load = mass * kG * (c.cg_to_rear_axle_m + c.cg_height_m * z_meas) / L;

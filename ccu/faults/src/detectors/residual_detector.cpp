@@ -207,8 +207,6 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     hold_sum_kN_ += residual_kN_;
     if (hold_slow_ >= p.hold_settle_samples) {
       hold_ref_ = true;
-      hold_eol_mode_ = eol_here;
-      hold_known_ = friction_known_;
       hold_r0_kN_ = hold_sum_kN_ / hold_slow_;
       hold_x0_rev_ = x_hold;
       hold_f0_kN_ = hold_curve_kN;

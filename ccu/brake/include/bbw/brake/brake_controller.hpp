@@ -55,7 +55,7 @@ class BrakeController {
   const BrakeControlParams& params() const { return p_; }
   // The mass the request and the load transfer use (the nominal one unless the estimate, less its
   // deadband, is above it) and the estimate itself.
-  double mass_used_kg() const { return mass_used_kg_; }
+  double mass_used_kg() const;
   double mass_estimate_kg() const { return mass_kg_; }
   // Wheel torque to clamp force through the CCU's brake model, and back.
   double clamp_kN(std::size_t wheel, double torque_Nm) const;
@@ -66,8 +66,7 @@ class BrakeController {
   SpeedEstimator speed_;
   std::array<SlipController, 4> slip_;
   double ax_filt_ = 0.0;
-  double mass_kg_ = 0.0;                // the mass estimate (MassEstimateParams)
-  double mass_used_kg_ = 0.0;
+  double mass_kg_ = 0.0;                // the mass estimate (MassEstimateParams), from the nominal mass
   std::array<double, 4> load_in_N_{};   // the loads the slip controllers were given last period
   std::array<double, 4> pads_off_s_{};  // how long each wheel's pads have been off the disc (WheelBrakeStatus)
   static std::size_t lost_corner(const BrakeMeasurements& m);  // the one unavailable corner, else 4
