@@ -468,6 +468,40 @@ TEST(FaultMonitor, TorqueBalanceSeparatesPartialAndTotalLoss) {
   EXPECT_EQ(run(0.1).finding, Finding::ActuatorLost);
 }
 
+// Applying at speed the drive's friction is known in sign and size, so the balance holds in motion
+// too: a motor that makes 40 % of its torque is named a torque loss during a 1.5 rev/s apply at 5
+// kN (below the standstill check's minimum load), a healthy one is not, nor a load cell 2 kN low,
+// nor the same loss while releasing (the load back-drives the screw); with the moving check off
+// it waits for a hold at a higher load.
+TEST(FaultMonitor, ATorqueLossIsNamedDuringAnApplyBelowTheHoldChecksLoad) {
+  MonitorParams base = noiseless();
+  SampleCheck ok;
+  auto run = [&](const MonitorParams& p, double fraction, double speed_rev_per_s, double true_kN, double lc_kN) {
+    FaultMonitor m(p, Target::FL);
+    const double friction_Nm = p.drive_friction_Nm * std::tanh(speed_rev_per_s / p.drive_friction_smoothing_rev_per_s) +
+                               p.drive_viscous_Nm_per_rev_per_s * speed_rev_per_s;
+    for (int k = 1; k < 200; ++k) {
+      const double t = 0.001 * k;
+      const double rise_kN = 2.0 * speed_rev_per_s * t;  // 2 kN/rev
+      auto r = at(k, t, 2.0 + speed_rev_per_s * t, lc_kN + rise_kN);
+      r.speed_rev_per_s = speed_rev_per_s + (k % 2 == 0 ? 1e-4 : -1e-4);  // a real speed never repeats exactly
+      r.motor_current_A = ((true_kN + rise_kN) * p.Nm_per_kN + friction_Nm) / (p.torque_per_A_Nm * fraction);
+      m.update(r, ok, nullptr, r.force_kN, t);
+    }
+    EXPECT_TRUE(m.ok(Part::LoadCell) && m.ok(Part::Resolver));
+    return m.diagnosis(Part::Actuator);
+  };
+  ASSERT_LT(5.0, base.torque_check_min_load_kN);
+  ASSERT_GE(5.0, base.torque_check_moving_min_load_kN);
+  EXPECT_FALSE(run(base, 1.0, 1.5, 5.0, 5.0).present);
+  EXPECT_EQ(run(base, 0.4, 1.5, 5.0, 5.0).finding, Finding::ActuatorTorqueLoss);
+  EXPECT_FALSE(run(base, 1.0, 1.5, 7.0, 5.0).present);   // the load cell 2 kN low
+  EXPECT_FALSE(run(base, 0.4, -1.5, 5.0, 5.0).present);  // releasing
+  MonitorParams off = base;
+  off.torque_check_moving_min_speed_rev_per_s = 0.0;
+  EXPECT_FALSE(run(off, 0.4, 1.5, 5.0, 5.0).present);
+}
+
 // Over-application: told to release (command 0) a brake that keeps 10 kN and does not move back
 // is named actuator_not_releasing after tracking_persist_s past the point where the force stands
 // above the commanded response by the tracking threshold; one that moves back (releasing, if

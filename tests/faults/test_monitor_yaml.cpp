@@ -55,7 +55,8 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(noise_window_samples); SAME(noise_step_kN); SAME(noise_min_fraction); SAME(dropout_samples); SAME(dropout_clear_samples);
   SAME(torque_per_A_Nm); SAME(Nm_per_kN); SAME(inertia_kg_m2);
   SAME(torque_filter_s); SAME(torque_check_min_load_kN); SAME(torque_check_min_torque_Nm);
-  SAME(torque_fraction_threshold); SAME(torque_check_max_speed_rev_per_s); SAME(torque_persist_s);
+  SAME(torque_fraction_threshold); SAME(torque_check_max_speed_rev_per_s); SAME(torque_check_moving_min_speed_rev_per_s); SAME(torque_check_moving_min_load_kN);
+  SAME(torque_persist_s);
   SAME(torque_lost_threshold); SAME(torque_lost_persist_s);
   SAME(tracking_time_constant_s); SAME(tracking_threshold_kN); SAME(tracking_relative); SAME(tracking_persist_s);
   SAME(force_limit_kN); SAME(release_min_speed_rev_per_s); SAME(deadline_s);

@@ -104,6 +104,12 @@ void MonitorParams::validate() const {
   positive("seized_force_error_kN", seized_force_error_kN);
   positive("torque_check_min_load_kN", torque_check_min_load_kN);
   positive("torque_check_max_speed_rev_per_s", torque_check_max_speed_rev_per_s);
+  require(std::isfinite(torque_check_moving_min_speed_rev_per_s) && torque_check_moving_min_speed_rev_per_s >= 0.0,
+          "torque_check_moving_min_speed_rev_per_s", torque_check_moving_min_speed_rev_per_s, "must be >= 0");
+  positive("torque_check_moving_min_load_kN", torque_check_moving_min_load_kN);
+  positive("drive_friction_smoothing_rev_per_s", drive_friction_smoothing_rev_per_s);
+  require(std::isfinite(drive_viscous_Nm_per_rev_per_s) && drive_viscous_Nm_per_rev_per_s >= 0.0,
+          "drive_viscous_Nm_per_rev_per_s", drive_viscous_Nm_per_rev_per_s, "must be >= 0");
   positive("torque_persist_s", torque_persist_s);
   positive("tracking_time_constant_s", tracking_time_constant_s);
   positive("tracking_threshold_kN", tracking_threshold_kN);
@@ -189,8 +195,9 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
     // No residual without the position: a noisy load cell is still found by its own differences.
     noise_.update_load_cell_difference(r.force_kN - prev_.force_kN, r.time_s, p_, arbiter_);
   }
-  const double load_kN = check.load_cell_present && arbiter_.ok(Part::LoadCell) ? r.force_kN : force_estimate_kN;
-  torque_.update(c, load_kN, p_, arbiter_);
+  const bool load_cell_load = check.load_cell_present && arbiter_.ok(Part::LoadCell);
+  const double load_kN = load_cell_load ? r.force_kN : force_estimate_kN;
+  torque_.update(c, load_kN, load_cell_load, p_, arbiter_);
   // Without commutation the force no longer follows the command because of the resolver, not of
   // a second fault in the actuator.
   if (commutation_lost()) {

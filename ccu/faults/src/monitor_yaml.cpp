@@ -101,6 +101,8 @@ MonitorParams read_monitor_params(Reader& r) {
   p.torque_check_min_torque_Nm = t.number("check_min_torque_Nm", pos);
   p.torque_fraction_threshold = t.number("fraction_threshold", Range{0.0, 1.0, true, true});
   p.torque_check_max_speed_rev_per_s = t.number("check_max_speed_rev_per_s", pos);
+  p.torque_check_moving_min_speed_rev_per_s = t.number("check_moving_min_speed_rev_per_s", Range::non_negative());
+  p.torque_check_moving_min_load_kN = t.number("check_moving_min_load_kN", pos);
   p.torque_persist_s = t.number("persist_s", pos);
   p.torque_lost_threshold = t.number("lost_threshold", Range{0.0, 1.0, true, true});
   p.torque_lost_persist_s = t.number("lost_persist_s", pos);

@@ -10,7 +10,8 @@ TorqueDetector::TorqueDetector(const MonitorParams& p) {
   if (p.eol_curve) eol_.emplace(*p.eol_curve);
 }
 
-void TorqueDetector::update(const SampleContext& c, double load_kN, const MonitorParams& p, DiagnosisArbiter& a) {
+void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_cell_load, const MonitorParams& p,
+                            DiagnosisArbiter& a) {
   const CornerReading& r = c.r;
   const double t = r.time_s;
   const double accel = c.have_prev && c.dt_s > 0.0 ? (r.speed_rev_per_s - c.prev.speed_rev_per_s) / c.dt_s : 0.0;
@@ -24,17 +25,28 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, const Monito
   constexpr double kTwoPi = 6.283185307179586;
   const double need = load_kN * p.Nm_per_kN + p.inertia_kg_m2 * kTwoPi * accel;
   const double make = r.motor_current_A * p.torque_per_A_Nm;
+  const double drive_friction = p.drive_friction_Nm * std::tanh(r.speed_rev_per_s / p.drive_friction_smoothing_rev_per_s) +
+                                p.drive_viscous_Nm_per_rev_per_s * r.speed_rev_per_s;
   if (!torque_init_ || c.dt_s <= 0.0) {
     torque_init_ = true;
     need_Nm_ = need;
     make_Nm_ = make;
+    friction_Nm_ = drive_friction;
   } else {
     const double k = -std::expm1(-c.dt_s / p.torque_filter_s);
     need_Nm_ += (need - need_Nm_) * k;
     make_Nm_ += (make - make_Nm_) * k;
+    friction_Nm_ += (drive_friction - friction_Nm_) * k;
   }
-  const bool checkable = load_kN >= p.torque_check_min_load_kN && make_Nm_ >= p.torque_check_min_torque_Nm;
-  const double fraction = checkable ? need_Nm_ / make_Nm_ : 1.0;
+  // Applying at speed the drive's friction opposes the motion with a known size, so it joins the
+  // need; at standstill it can take any value within its band and is left out (the load is large
+  // against it above the check's minimum load). Only with the load cell's load: the force
+  // estimate is the clamp force, without the key friction the drive pushes against in motion.
+  const bool applying = load_cell_load && p.torque_check_moving_min_speed_rev_per_s > 0.0 &&
+                        r.speed_rev_per_s >= p.torque_check_moving_min_speed_rev_per_s;
+  const bool checkable = load_kN >= (applying ? p.torque_check_moving_min_load_kN : p.torque_check_min_load_kN) &&
+                         make_Nm_ >= p.torque_check_min_torque_Nm;
+  const double fraction = !checkable ? 1.0 : applying ? (need_Nm_ + friction_Nm_) / make_Nm_ : need_Nm_ / make_Nm_;
   if (checkable) fraction_ = fraction;
   if (checkable && fraction < p.torque_lost_threshold) {
     if (!lost_suspect_) {
@@ -109,7 +121,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, const Monito
     unexplained_suspect_ = false;
   }
   const bool still = std::abs(r.speed_rev_per_s) <= p.torque_check_max_speed_rev_per_s;
-  if (checkable && still && fraction < p.torque_fraction_threshold && !winding_up) {
+  if (checkable && (still || applying) && fraction < p.torque_fraction_threshold && !winding_up) {
     if (!torque_suspect_) {
       torque_suspect_ = true;
       torque_onset_s_ = t;

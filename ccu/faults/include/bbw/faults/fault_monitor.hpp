@@ -182,6 +182,14 @@ struct MonitorParams {
   double torque_check_min_torque_Nm = 0.2;    // expected torque below this: no check
   double torque_fraction_threshold = 0.6;     // at standstill, below this: torque loss (kept in use)
   double torque_check_max_speed_rev_per_s = 0.5;
+  // Applying (issue 14): at or above this speed the drive's Coulomb and viscous friction are
+  // known in sign and size, and the balance need + friction against made holds in motion too, so
+  // a torque loss is named during the apply instead of at the next hold (0: off).
+  double torque_check_moving_min_speed_rev_per_s = 0.5;
+  // ... and from this load on (the drive's friction is then known, not bounded: a load cell
+  // reading b kN low gives the fraction 1 - b / (load + friction / Nm_per_kN), which stays above
+  // torque_fraction_threshold for biases up to the largest the campaigns draw).
+  double torque_check_moving_min_load_kN = 4.0;
   double torque_persist_s = 0.04;
   double torque_lost_threshold = 0.25;        // at any speed, below this: the actuator is lost
   double torque_lost_persist_s = 0.015;
@@ -192,6 +200,8 @@ struct MonitorParams {
   // backlash gap carries none of the load the load cell reads). For unexplained_persist_s:
   // ActuatorLost.
   double drive_friction_Nm = 0.05;            // the drive's Coulomb friction at the spindle (the plant's transmission)
+  double drive_friction_smoothing_rev_per_s = 0.2;  // its tanh smoothing speed (the plant's transmission)
+  double drive_viscous_Nm_per_rev_per_s = 0.002;    // the drive's viscous friction (the plant's transmission)
   double unexplained_margin_Nm = 0.1;
   double unexplained_relative = 0.3;
   double unexplained_max_speed_rev_per_s = 2.0;

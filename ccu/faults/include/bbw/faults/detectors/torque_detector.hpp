@@ -2,7 +2,8 @@
 // load * Nm_per_kN + J 2 pi a, against the torque the measured current should make,
 // i * torque_per_A; both low-pass filtered, their ratio is the delivered torque fraction. Below
 // torque_lost_threshold at any speed: ActuatorLost; below torque_fraction_threshold at
-// standstill: ActuatorTorqueLoss. Near standstill at any load, a made torque that neither the
+// standstill, or applying at speed with the drive's friction added to the need:
+// ActuatorTorqueLoss. Near standstill at any load, a made torque that neither the
 // load cell's load nor the end-of-line curve's (with its band), the acceleration and the drive's
 // friction explain, and of which less than torque_lost_threshold would be needed
 // (MonitorParams::unexplained_*): ActuatorLost. A load-cell fault moves only one of the two
@@ -22,8 +23,8 @@ namespace bbw::faults {
 class TorqueDetector {
  public:
   explicit TorqueDetector(const MonitorParams& p);
-  // `load_kN`: the load cell while it is trusted, else the CCU's force estimate.
-  void update(const SampleContext& c, double load_kN, const MonitorParams& p, DiagnosisArbiter& a);
+  // `load_kN`: the load cell while it is trusted (`load_cell_load`), else the CCU's force estimate.
+  void update(const SampleContext& c, double load_kN, bool load_cell_load, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() {
     torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = static_init_ = false;
     speed_repeats_ = 0;
@@ -40,6 +41,7 @@ class TorqueDetector {
   bool torque_init_ = false;
   double need_Nm_ = 0.0;
   double make_Nm_ = 0.0;
+  double friction_Nm_ = 0.0;  // filtered drive friction at the measured speed
   double fraction_ = 1.0;
   std::optional<plant::ClampCurve> eol_;  // the end-of-line curve: a load the load cell does not give
   bool unexplained_init_ = false;
