@@ -46,6 +46,15 @@ void ControllerParams::validate() const {
   positive("stiffness_memory_rev", stiffness_memory_rev);
   non_negative("stiffness_reversal_rev", stiffness_reversal_rev);
   positive("stiffness_hold_rev", stiffness_hold_rev);
+  non_negative("hold_test_current_A", hold_test_current_A);
+  positive("hold_test_pulse_s", hold_test_pulse_s);
+  positive("hold_test_period_s", hold_test_period_s);
+  non_negative("hold_test_min_hold_s", hold_test_min_hold_s);
+  non_negative("hold_test_min_force_kN", hold_test_min_force_kN);
+  positive("hold_test_max_speed_rev_per_s", hold_test_max_speed_rev_per_s);
+  positive("hold_test_max_error_kN", hold_test_max_error_kN);
+  if (hold_test_current_A > 0.0 && 2.0 * hold_test_pulse_s >= hold_test_period_s)
+    throw std::invalid_argument("hold_test_pulse_s must be shorter than half hold_test_period_s");
   if (frozen_resolver_samples < 0) throw std::invalid_argument("frozen_resolver_samples must be >= 0 (0: off)");
   if (!(std::isfinite(stiffness_max_ratio) && stiffness_max_ratio >= 1.0)) {
     std::ostringstream os;
@@ -163,13 +172,23 @@ ControllerOutput LocalController::update_force(double force_command_kN, const Co
                                                double dt_s, double force_rate_kN_per_s) {
   if (!(dt_s > 0.0)) return ControllerOutput{};
   if (force_command_kN <= p_.release_force_kN) {
+    s_.hold_s = 0.0;
+    s_.pulse_s = -1.0;
     s_.releasing = true;
     s_.force_integral_kN_s = 0.0;
     s_.stiffness.started = false;  // a new apply starts from the nominal slope
     return update_position(PositionReference{p_.release_position_rev, 0.0, 0.0}, in, dt_s);
   }
   s_.releasing = false;
-  if (resolver_frozen(in)) return ControllerOutput{};
+  if (resolver_frozen(in)) {
+    s_.hold_s = 0.0;
+    s_.pulse_s = -1.0;
+    return ControllerOutput{};
+  }
+  {
+    ControllerOutput pulse;
+    if (pulse_step(dt_s, pulse)) return pulse;
+  }
   const double e = force_command_kN - in.force_feedback_kN;
   update_stiffness(p_.stiffness_at_zero_kN_per_rev + p_.stiffness_per_kN_per_rev * std::max(in.force_feedback_kN, 0.0),
                    in);
@@ -184,7 +203,44 @@ ControllerOutput LocalController::update_force(double force_command_kN, const Co
     s_.force_integral_kN_s += e * dt_s;
   }
   out.saturated = clipped;
+  hold_test(force_command_kN, e, in, dt_s, out);
   return out;
+}
+
+void LocalController::hold_test(double force_command_kN, double error_kN, const ControllerInputs& in, double dt_s,
+                                ControllerOutput& out) {
+  if (!(p_.hold_test_current_A > 0.0)) return;
+  const bool holding = force_command_kN >= p_.hold_test_min_force_kN &&
+                       std::abs(in.speed_rev_per_s) <= p_.hold_test_max_speed_rev_per_s &&
+                       std::abs(error_kN) <= p_.hold_test_max_error_kN && !out.saturated;
+  if (!holding) {
+    s_.hold_s = 0.0;
+    return;
+  }
+  s_.hold_s += dt_s;
+  s_.since_test_s += dt_s;
+  if (s_.hold_s >= p_.hold_test_min_hold_s && s_.since_test_s >= p_.hold_test_period_s) {
+    // The pulse starts with the next sample, on top of this sample's loop current, which the
+    // loops hold (integrators and all) until it is over.
+    s_.pulse_s = 0.0;
+    s_.since_test_s = 0.0;
+    s_.pulse_base_A = out.current_command_A;
+  }
+}
+
+bool LocalController::pulse_step(double dt_s, ControllerOutput& out) {
+  if (s_.pulse_s < 0.0) return false;
+  // Back first, then forth, each by the hold's own current and the test current more: the current
+  // changes sign both ways, so a gear held against its flank (backlash) or a spindle held by its
+  // friction still lets the rotor move.
+  const double sign = s_.pulse_s < p_.hold_test_pulse_s - 1e-12 ? -1.0 : 1.0;
+  const double amplitude_A = std::abs(s_.pulse_base_A) + p_.hold_test_current_A;
+  out = ControllerOutput{};
+  out.current_command_A =
+      std::clamp(s_.pulse_base_A + sign * amplitude_A, -p_.current_limit_A, p_.current_limit_A);
+  s_.pulse_s += dt_s;
+  if (s_.pulse_s >= 2.0 * p_.hold_test_pulse_s - 1e-12) s_.pulse_s = -1.0;
+  return true;
 }
 
 }  // namespace bbw::corner_unit

@@ -27,6 +27,9 @@ faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, fau
   base.drive_friction_Nm = scenario.plant.transmission.coulomb_friction_Nm;
   base.drive_friction_smoothing_rev_per_s = scenario.plant.transmission.coulomb_smoothing_rev_per_s;
   base.drive_viscous_Nm_per_rev_per_s = scenario.plant.transmission.viscous_friction_Nm_per_rev_per_s;
+  // The corners' actuator test in holds (their controller's hold_test_*).
+  base.test_pulse_current_A = scenario.controller.hold_test_current_A;
+  base.test_pulse_s = scenario.controller.hold_test_pulse_s;
   // The caliper's end-of-line curve and key-friction width (measured on its production line):
   // the residual's reference before the first fit and beyond the fitted range (issue 14).
   base.eol_curve = scenario.plant.curve;

@@ -235,6 +235,40 @@ TEST(ClosedLoop, ASeizedActuatorIsNamedNotReleasingAndItsHeldForceIsCounted) {
   EXPECT_LT(d.finding_s - fs.faults.faults[0].at_s, 1.0);
 }
 
+// A drive that seizes in the middle of a held stop keeps its force where it is commanded, so no
+// rule that waits for motion sees it before the release. The corners' actuator test in holds
+// (back and forth by the hold's current and 1.5 A more, 3 ms each, every 0.15 s) gives the
+// monitor a rotor that does not answer: actuator_lost within the scorer's 0.5 s for a seized
+// drive, long before the release. The healthy corners answer, FR with a backlash in its gear
+// too (a gear held against its flank moves back when the current changes sign).
+TEST(ClosedLoop, ADriveThatSeizesInAHoldIsFoundByTheActuatorTestBeforeTheRelease) {
+  const auto fs = load("config/scenarios/faults/actuator_seized_in_hold.yaml");
+  ASSERT_GT(fs.scenario.controller.hold_test_current_A, 0.0);
+  const double seized_at_s = fs.faults.faults.at(0).at_s;
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct);
+  EXPECT_EQ(r.outcomes[0].diagnosis, Finding::ActuatorNotReleasing);  // actuator_lost, refined at the release
+  const Diagnosis& fl = r.diagnoses[0 * 5 + static_cast<std::size_t>(Part::Actuator)];
+  ASSERT_TRUE(fl.present);
+  EXPECT_GT(fl.detected_s, seized_at_s);
+  EXPECT_LT(fl.detected_s - seized_at_s, 0.5);
+  for (std::size_t c = 1; c < kCorners; ++c) {
+    EXPECT_FALSE(r.diagnoses[c * 5 + static_cast<std::size_t>(Part::Actuator)].present) << "corner " << c;
+  }
+  auto off = fs;
+  off.scenario.controller.hold_test_current_A = 0.0;
+  const auto base = run_closed_loop(off, default_options());
+  const Diagnosis& fl_off = base.diagnoses[0 * 5 + static_cast<std::size_t>(Part::Actuator)];
+  ASSERT_TRUE(fl_off.present);
+  // Without it only the seized rule's current ramp (the loop's integrators wind up against the
+  // rotor as the key friction relaxes) finds it, outside the scorer's 0.5 s.
+  EXPECT_GT(fl_off.detected_s - seized_at_s, 0.5);
+  EXPECT_LT(fl.detected_s, fl_off.detected_s);
+  std::printf("seized in a hold at %.1f s: found %.0f ms later with the actuator test, %.0f ms later without it\n",
+              seized_at_s, 1e3 * (fl.detected_s - seized_at_s), 1e3 * (fl_off.detected_s - seized_at_s));
+}
+
 TEST(ClosedLoop, CorruptSamplesNeverChangeACommandOrAnEstimate) {
   const auto fs = load("config/scenarios/faults/fault_free_stop.yaml");
   const auto clean = run_closed_loop(fs, default_options());

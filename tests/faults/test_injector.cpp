@@ -128,7 +128,11 @@ TEST(FaultInjector, InCornerSimTheBiasReachesSampleAndLoopAndTotalLossReleasesTh
   auto f = spec(FaultType::Bias, Part::LoadCell, 7.0);
   f.bias_kN = 2.0;
   FaultInjector inj(one(f), Target::FL, 3);
-  bbw::scenario::CornerSim healthy(fs.scenario, 0), faulty(fs.scenario, 0);
+  // The actuator test in holds off: its pulses, every 0.15 s from where each hold began, move
+  // the key friction for a few ms, and the healthy and the faulty corner's holds begin apart.
+  auto scenario = fs.scenario;
+  scenario.controller.hold_test_current_A = 0.0;
+  bbw::scenario::CornerSim healthy(scenario, 0), faulty(scenario, 0);
   for (int k = 0; k < 7500; ++k) {
     bbw::scenario::ExternalInputs ext;
     ext.force_command_kN = 20.0;

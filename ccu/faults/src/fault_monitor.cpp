@@ -102,6 +102,14 @@ void MonitorParams::validate() const {
   positive("seized_window_s", seized_window_s);
   positive("seized_ramp_Nm", seized_ramp_Nm);
   positive("seized_force_error_kN", seized_force_error_kN);
+  require(std::isfinite(test_pulse_current_A) && test_pulse_current_A >= 0.0, "test_pulse_current_A",
+          test_pulse_current_A, "must be >= 0");
+  require(test_pulse_s >= 0.0005 && test_pulse_s <= 0.014, "test_pulse_s", test_pulse_s, "must be in [0.0005, 0.014]");
+  positive("test_pulse_max_speed_rev_per_s", test_pulse_max_speed_rev_per_s);
+  require(test_pulse_answer_ratio > 0.0 && test_pulse_answer_ratio < 1.0, "test_pulse_answer_ratio",
+          test_pulse_answer_ratio, "must be in (0, 1)");
+  require(test_pulse_unanswered >= 1, "test_pulse_unanswered", test_pulse_unanswered, "must be >= 1");
+  positive("test_pulse_within_s", test_pulse_within_s);
   positive("torque_check_min_load_kN", torque_check_min_load_kN);
   positive("torque_check_max_speed_rev_per_s", torque_check_max_speed_rev_per_s);
   require(std::isfinite(torque_check_moving_min_speed_rev_per_s) && torque_check_moving_min_speed_rev_per_s >= 0.0,

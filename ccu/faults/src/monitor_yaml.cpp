@@ -103,6 +103,10 @@ MonitorParams read_monitor_params(Reader& r) {
   p.torque_check_max_speed_rev_per_s = t.number("check_max_speed_rev_per_s", pos);
   p.torque_check_moving_min_speed_rev_per_s = t.number("check_moving_min_speed_rev_per_s", Range::non_negative());
   p.torque_check_moving_min_load_kN = t.number("check_moving_min_load_kN", pos);
+  p.test_pulse_max_speed_rev_per_s = t.number("test_pulse_max_speed_rev_per_s", pos);
+  p.test_pulse_answer_ratio = t.number("test_pulse_answer_ratio", Range{0.0, 1.0, true, true});
+  p.test_pulse_unanswered = static_cast<int>(t.integer("test_pulse_unanswered", 1, 1000));
+  p.test_pulse_within_s = t.number("test_pulse_within_s", pos);
   p.torque_persist_s = t.number("persist_s", pos);
   p.torque_lost_threshold = t.number("lost_threshold", Range{0.0, 1.0, true, true});
   p.torque_lost_persist_s = t.number("lost_persist_s", pos);

@@ -20,8 +20,10 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   speed_repeats_ = repeated ? speed_repeats_ + 1 : 0;
   if (!a.ok(Part::Resolver) || !std::isfinite(load_kN) || speed_repeats_ >= p.frozen_attribution_samples) {
     torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = static_init_ = false;
+    reset_response();
     return;
   }
+  update_response(c, p, a);
   constexpr double kTwoPi = 6.283185307179586;
   const double need = load_kN * p.Nm_per_kN + p.inertia_kg_m2 * kTwoPi * accel;
   const double make = r.motor_current_A * p.torque_per_A_Nm;
@@ -129,6 +131,69 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
     if (t - torque_onset_s_ >= p.torque_persist_s) a.confirm(Finding::ActuatorTorqueLoss, torque_onset_s_, t);
   } else {
     torque_suspect_ = false;
+  }
+}
+
+void TorqueDetector::update_response(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a) {
+  if (!(p.test_pulse_current_A > 0.0)) return;
+  const CornerReading& r = c.r;
+  // Consecutive samples about one period apart, or the history starts again.
+  if (!c.have_prev || !(c.dt_s > 0.0) || c.dt_s > 0.0015 || !std::isfinite(r.motor_current_A) ||
+      !std::isfinite(r.speed_rev_per_s)) {
+    response_count_ = 0;
+  }
+  const int size = kMaxResponseWindow + 1;
+  response_head_ = (response_head_ + 1) % size;
+  response_speed_[static_cast<std::size_t>(response_head_)] = r.speed_rev_per_s;
+  response_current_[static_cast<std::size_t>(response_head_)] = r.motor_current_A;
+  response_count_ = std::min(response_count_ + 1, size);
+  const double dt_s = c.dt_s > 0.0 ? c.dt_s : 0.001;
+  const int m = std::max(1, static_cast<int>(std::lround(p.test_pulse_s / dt_s)));
+  if (2 * m + 2 > response_count_ || 2 * m + 2 > size) return;
+  const auto at = [&](int back) { return static_cast<std::size_t>((response_head_ - back + size) % size); };
+  const double amp_A = p.test_pulse_current_A;
+  // A pulse whose - half (back) ran over the samples 2m .. m+1 back and its + half (forth) over
+  // m .. 1 back: it fell into its first sample by at least half the test current, the halves'
+  // means are at least 1.3 test currents apart (at least 2, less the current's lag) and every +
+  // sample stands 0.8 of it above every - one (a hold's own current jitters by a few tenths of an
+  // A from sample to sample, the pulse rides on the loop's current of the sample before it).
+  double plus_A = 0.0, minus_A = 0.0, plus_min_A = 1e300, minus_max_A = -1e300;
+  for (int k = 1; k <= m; ++k) {
+    const double down = response_current_[at(m + k)], up = response_current_[at(k)];
+    plus_A += up / m;
+    minus_A += down / m;
+    plus_min_A = std::min(plus_min_A, up);
+    minus_max_A = std::max(minus_max_A, down);
+  }
+  const bool fell = response_current_[at(2 * m)] - response_current_[at(2 * m + 1)] <= -0.5 * amp_A;
+  // ... and the current changes sign both ways, as the test's does (a = |I| + the test current),
+  // and a hold's own current changing within a few milliseconds hardly ever does.
+  const bool crosses = minus_A <= -0.5 * amp_A && plus_A >= 0.5 * amp_A;
+  const bool square =
+      fell && crosses && plus_A - minus_A >= 1.3 * amp_A && plus_min_A - minus_max_A >= 0.8 * amp_A;
+  const double v0 = response_speed_[at(2 * m + 1)];
+  if (!square || std::abs(v0) > p.test_pulse_max_speed_rev_per_s) return;
+  constexpr double kTwoPi = 6.283185307179586;
+  // A free rotor's answer to the measured swing: each half's current is half the swing off the
+  // middle, so each half accelerates by that much torque.
+  const double accel = 0.5 * (plus_A - minus_A) * p.torque_per_A_Nm / (kTwoPi * p.inertia_kg_m2);
+  // The speed's fall over the - half less its fall over the + half (each from the speed before
+  // the half): an acceleration the rotor had anyway (the load against the held current) cancels.
+  const double vm = response_speed_[at(m + 1)];
+  double measured = 0.0;
+  for (int k = 1; k <= m; ++k) measured += (v0 - response_speed_[at(m + k)]) - (vm - response_speed_[at(k)]);
+  const double free_rotor = 2.0 * accel * dt_s * m * (m + 1) / 2.0;
+  const double ratio = measured / free_rotor;
+  // Unanswered pulses count in a row only while each follows the last judged one within
+  // test_pulse_within_s (a test every hold_test_period_s while the hold lasts).
+  if (unanswered_ > 0 && r.time_s - last_pulse_s_ > p.test_pulse_within_s) unanswered_ = 0;
+  last_pulse_s_ = r.time_s;
+  if (ratio < p.test_pulse_answer_ratio) {
+    if (unanswered_ == 0) unanswered_since_s_ = r.time_s - (2 * m + 1) * dt_s;
+    ++unanswered_;
+    if (unanswered_ >= p.test_pulse_unanswered) a.confirm(Finding::ActuatorLost, unanswered_since_s_, r.time_s);
+  } else {
+    unanswered_ = 0;
   }
 }
 

@@ -59,6 +59,24 @@ struct ControllerParams {
   // this a stuck resolver wound the speed loop up and drove the caliper into an oscillation of
   // hundreds of kN, tuning seed 1403 run 34). 0: off.
   int frozen_resolver_samples = 20;
+  // Actuator test in holds (issue 14): a drive that seizes while it holds a force shows nothing
+  // until the next change of command, since the force stays where it is. After hold_test_min_hold_s
+  // of a hold (force mode, command >= hold_test_min_force_kN, |speed| <= hold_test_max_speed_rev_per_s,
+  // |force error| <= hold_test_max_error_kN), and then every hold_test_period_s, the loops hold their
+  // current I and the command is I - a for hold_test_pulse_s, then I + a for as long, with
+  // a = |I| + hold_test_current_A: the current changes sign both ways, so the rotor moves even when
+  // a gear rests on its flank in a backlash (the load holds it there against any smaller change)
+  // or the spindle's friction holds the load; its inertia takes the pulse (about 0.1-0.5 mrev of
+  // travel, a clamp force change of a few N to a few tens of N against sticking key friction) and
+  // the CCU's monitor compares the rotor's speed with what the measured current gives a free rotor
+  // (faults::MonitorParams::test_pulse_*). 0 A: off.
+  double hold_test_current_A = 1.5;
+  double hold_test_pulse_s = 0.003;
+  double hold_test_period_s = 0.15;
+  double hold_test_min_hold_s = 0.1;
+  double hold_test_min_force_kN = 1.0;
+  double hold_test_max_speed_rev_per_s = 0.5;
+  double hold_test_max_error_kN = 0.5;
 
   void validate() const;  // throws std::invalid_argument naming the field
 };
@@ -110,6 +128,12 @@ struct ControllerState {
   double last_position_rev = 0.0, last_speed_rev_per_s = 0.0;
   int resolver_repeats = 0;
   bool resolver_frozen = false;        // the current is 0 (see frozen_resolver_samples)
+  // The actuator test in holds: how long the hold has lasted, the time since the last pulse, and
+  // where the running pulse is (< 0: none).
+  double hold_s = 0.0;
+  double since_test_s = 0.0;
+  double pulse_s = -1.0;
+  double pulse_base_A = 0.0;           // the loop's current the pulse rides on
 };
 
 struct ControllerOutput {
@@ -138,6 +162,11 @@ class LocalController {
   // Updates the estimate: s_.stiffness.stiffness_kN_per_rev (feedforward) and held_kN_per_rev
   // (feedback), both >= the model.
   void update_stiffness(double model_kN_per_rev, const ControllerInputs& in);
+  // The actuator test in holds (ControllerParams::hold_test_*): adds the pulse to `out`.
+  void hold_test(double force_command_kN, double error_kN, const ControllerInputs& in, double dt_s,
+                 ControllerOutput& out);
+  // Within a pulse: its current in `out` (the loops held), true; else false.
+  bool pulse_step(double dt_s, ControllerOutput& out);
 
   ControllerParams p_;
   ControllerState s_;

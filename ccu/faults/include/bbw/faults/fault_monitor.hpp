@@ -216,6 +216,21 @@ struct MonitorParams {
   double seized_window_s = 0.1;
   double seized_ramp_Nm = 0.3;
   double seized_force_error_kN = 0.5;
+  // The corners' actuator test in holds (issue 14; corner_unit::ControllerParams::hold_test_*,
+  // set from the scenario): the loops hold their current and the command steps by
+  // +test_pulse_current_A for test_pulse_s, then by - as much. Seen in the measured current (a
+  // rise of at least 0.7 of it from one sample to the next, from a rotor at most
+  // test_pulse_max_speed_rev_per_s fast, and the swing 1.4 of it test_pulse_s later), the
+  // rotor's speed over the + half, summed over its samples, against the sum the pulse's torque
+  // gives a free rotor (I torque_per_A t / (2 pi J) at each sample): below test_pulse_answer_ratio,
+  // the pulse was not answered; test_pulse_unanswered such in a row: ActuatorLost (a seized drive
+  // or a motor that makes no torque). 0 A: no test.
+  double test_pulse_current_A = 0.0;
+  double test_pulse_s = 0.003;
+  double test_pulse_max_speed_rev_per_s = 0.2;
+  double test_pulse_answer_ratio = 0.15;
+  int test_pulse_unanswered = 2;
+  double test_pulse_within_s = 0.4;           // each unanswered pulse within this of the last judged one
   // Tracking backstop: the force against a first-order model of the commanded response. A
   // shortfall below both is ActuatorTracking; an excess above both (a brake that does not
   // release) is ActuatorNotReleasing, with the same threshold and persistence.

@@ -13,6 +13,7 @@
 // the balance named a stuck resolver a lost actuator 3 ms before the stuck rule could; issue 14).
 #pragma once
 
+#include <array>
 #include <optional>
 
 #include "bbw/faults/detectors/detector.hpp"
@@ -25,9 +26,11 @@ class TorqueDetector {
   explicit TorqueDetector(const MonitorParams& p);
   // `load_kN`: the load cell while it is trusted (`load_cell_load`), else the CCU's force estimate.
   void update(const SampleContext& c, double load_kN, bool load_cell_load, const MonitorParams& p, DiagnosisArbiter& a);
+  static constexpr int kMaxResponseWindow = 16;
   void on_rejoin() {
     torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = static_init_ = false;
     speed_repeats_ = 0;
+    reset_response();
   }
   double fraction() const { return fraction_; }
   // Filtered made - needed torque at the last checked sample (the unexplained-torque rule's).
@@ -51,6 +54,20 @@ class TorqueDetector {
   double unexplained_onset_s_ = 0.0;
   double excess_Nm_ = 0.0;
   int speed_repeats_ = 0;  // samples whose speed equals the previous one exactly
+  // The corners' actuator test in holds (MonitorParams::test_pulse_*): the last samples' speed and
+  // current, and the pulses not answered in a row.
+  void reset_response() {
+    response_count_ = 0;
+    unanswered_ = 0;
+  }
+  void update_response(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a);
+  std::array<double, kMaxResponseWindow + 1> response_speed_{};
+  std::array<double, kMaxResponseWindow + 1> response_current_{};
+  int response_count_ = 0;  // consecutive samples held (up to the array's size)
+  int response_head_ = 0;
+  int unanswered_ = 0;
+  double unanswered_since_s_ = 0.0;
+  double last_pulse_s_ = 0.0;  // when the last pulse was judged
   // The seized-in-a-hold rule: where and when the drive stopped, the least made torque since.
   bool static_init_ = false;
   double static_position_rev_ = 0.0;
