@@ -174,7 +174,7 @@ corner_unit::ControllerParams read_controller(Reader& c) {
   p.stiffness_max_ratio = c.number_or("stiffness_max_ratio", p.stiffness_max_ratio, Range::closed(1.0, 1.0e4));
   p.frozen_resolver_samples = static_cast<int>(c.integer_or("frozen_resolver_samples", p.frozen_resolver_samples, 0, 100000));
   p.hold_test_current_A = c.number_or("hold_test_current_A", p.hold_test_current_A, Range::closed(0.0, 10.0));
-  p.hold_test_pulse_s = c.number_or("hold_test_pulse_s", p.hold_test_pulse_s, Range::closed(0.0005, 0.014));
+  p.hold_test_pulse_s = c.number_or("hold_test_pulse_s", p.hold_test_pulse_s, Range::closed(0.0005, 0.007));
   p.hold_test_period_s = c.number_or("hold_test_period_s", p.hold_test_period_s, Range::closed(0.01, 10.0));
   p.hold_test_min_hold_s = c.number_or("hold_test_min_hold_s", p.hold_test_min_hold_s, Range::closed(0.0, 10.0));
   p.hold_test_min_force_kN = c.number_or("hold_test_min_force_kN", p.hold_test_min_force_kN, Range::closed(0.0, 100.0));

@@ -104,7 +104,7 @@ void MonitorParams::validate() const {
   positive("seized_force_error_kN", seized_force_error_kN);
   require(std::isfinite(test_pulse_current_A) && test_pulse_current_A >= 0.0, "test_pulse_current_A",
           test_pulse_current_A, "must be >= 0");
-  require(test_pulse_s >= 0.0005 && test_pulse_s <= 0.014, "test_pulse_s", test_pulse_s, "must be in [0.0005, 0.014]");
+  require(test_pulse_s >= 0.0005 && test_pulse_s <= 0.007, "test_pulse_s", test_pulse_s, "must be in [0.0005, 0.007]");
   positive("test_pulse_max_speed_rev_per_s", test_pulse_max_speed_rev_per_s);
   require(test_pulse_answer_ratio > 0.0 && test_pulse_answer_ratio < 1.0, "test_pulse_answer_ratio",
           test_pulse_answer_ratio, "must be in (0, 1)");

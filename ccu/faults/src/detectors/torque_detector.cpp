@@ -137,11 +137,10 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
 void TorqueDetector::update_response(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a) {
   if (!(p.test_pulse_current_A > 0.0)) return;
   const CornerReading& r = c.r;
-  // Consecutive samples about one period apart, or the history starts again.
-  if (!c.have_prev || !(c.dt_s > 0.0) || c.dt_s > 0.0015 || !std::isfinite(r.motor_current_A) ||
-      !std::isfinite(r.speed_rev_per_s)) {
-    response_count_ = 0;
-  }
+  // Consecutive samples evenly spaced (a gap, a late or a lost sample: the history starts again).
+  const bool even = c.have_prev && c.dt_s > 0.0 && (response_count_ == 0 || std::abs(c.dt_s - response_dt_s_) <= 0.25 * response_dt_s_);
+  if (!even || !std::isfinite(r.motor_current_A) || !std::isfinite(r.speed_rev_per_s)) response_count_ = 0;
+  if (c.dt_s > 0.0) response_dt_s_ = c.dt_s;
   const int size = kMaxResponseWindow + 1;
   response_head_ = (response_head_ + 1) % size;
   response_speed_[static_cast<std::size_t>(response_head_)] = r.speed_rev_per_s;

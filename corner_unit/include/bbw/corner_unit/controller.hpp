@@ -71,7 +71,7 @@ struct ControllerParams {
   // the CCU's monitor compares the rotor's speed with what the measured current gives a free rotor
   // (faults::MonitorParams::test_pulse_*). 0 A: off.
   double hold_test_current_A = 1.5;
-  double hold_test_pulse_s = 0.003;
+  double hold_test_pulse_s = 0.003;          // at most 7 sample periods (the monitor's history)
   double hold_test_period_s = 0.15;
   double hold_test_min_hold_s = 0.1;
   double hold_test_min_force_kN = 1.0;

@@ -217,14 +217,15 @@ struct MonitorParams {
   double seized_ramp_Nm = 0.3;
   double seized_force_error_kN = 0.5;
   // The corners' actuator test in holds (issue 14; corner_unit::ControllerParams::hold_test_*,
-  // set from the scenario): the loops hold their current and the command steps by
-  // +test_pulse_current_A for test_pulse_s, then by - as much. Seen in the measured current (a
-  // rise of at least 0.7 of it from one sample to the next, from a rotor at most
-  // test_pulse_max_speed_rev_per_s fast, and the swing 1.4 of it test_pulse_s later), the
-  // rotor's speed over the + half, summed over its samples, against the sum the pulse's torque
-  // gives a free rotor (I torque_per_A t / (2 pi J) at each sample): below test_pulse_answer_ratio,
-  // the pulse was not answered; test_pulse_unanswered such in a row: ActuatorLost (a seized drive
-  // or a motor that makes no torque). 0 A: no test.
+  // set from the scenario): the loops hold their current I, the command is I - a for test_pulse_s,
+  // then I + a, a = |I| + test_pulse_current_A. Recognised in the measured current (it fell by at
+  // least half the test current into the - half; the halves' means of opposite signs, each at
+  // least half the test current off 0 and 1.3 test currents apart; every + sample 0.8 of it above
+  // every - one), from a rotor at most test_pulse_max_speed_rev_per_s fast: the rotor's speed
+  // over it (the fall over the - half less the fall over the + half) against a free rotor's under
+  // that current. Below test_pulse_answer_ratio: not answered; test_pulse_unanswered such, each
+  // within test_pulse_within_s of the last judged pulse: ActuatorLost (a seized drive or a motor
+  // that makes no torque). 0 A: no test. test_pulse_s at most 7 sample periods.
   double test_pulse_current_A = 0.0;
   double test_pulse_s = 0.003;
   double test_pulse_max_speed_rev_per_s = 0.2;

@@ -64,6 +64,7 @@ class TorqueDetector {
   std::array<double, kMaxResponseWindow + 1> response_speed_{};
   std::array<double, kMaxResponseWindow + 1> response_current_{};
   int response_count_ = 0;  // consecutive samples held (up to the array's size)
+  double response_dt_s_ = 0.0;  // their spacing
   int response_head_ = 0;
   int unanswered_ = 0;
   double unanswered_since_s_ = 0.0;
