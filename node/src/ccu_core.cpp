@@ -24,12 +24,17 @@ faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, fau
   base.torque_per_A_Nm = act.torque_per_A_Nm;
   base.Nm_per_kN = act.Nm_per_kN;
   base.inertia_kg_m2 = act.inertia_kg_m2;
-  base.drive_friction_Nm = scenario.plant.transmission.coulomb_friction_Nm;
-  base.drive_friction_smoothing_rev_per_s = scenario.plant.transmission.coulomb_smoothing_rev_per_s;
-  base.drive_viscous_Nm_per_rev_per_s = scenario.plant.transmission.viscous_friction_Nm_per_rev_per_s;
+  base.drive = scenario.plant.transmission;
   // The corners' actuator test in holds (their controller's hold_test_*).
   base.test_pulse_current_A = scenario.controller.hold_test_current_A;
   base.test_pulse_s = scenario.controller.hold_test_pulse_s;
+  const long pulse_samples = std::lround(base.test_pulse_s / scenario.plant_dt_s);
+  if (base.test_pulse_current_A > 0.0 && pulse_samples > faults::TorqueDetector::kMaxPulseSamples) {
+    throw std::invalid_argument("controller.hold_test_pulse_s = " + std::to_string(base.test_pulse_s) + " s is " +
+                                std::to_string(pulse_samples) + " samples of plant_dt_s = " +
+                                std::to_string(scenario.plant_dt_s) + " s: the CCU judges test pulses of at most " +
+                                std::to_string(faults::TorqueDetector::kMaxPulseSamples) + " samples");
+  }
   // The caliper's end-of-line curve and key-friction width (measured on its production line):
   // the residual's reference before the first fit and beyond the fitted range (issue 14).
   base.eol_curve = scenario.plant.curve;

@@ -78,10 +78,8 @@ void Plant::substep(double i_cmd_A, double torque_scale, bool seized, double h_s
   const bool loaded = !e_.backlash.enabled || gap >= half_play - 1e-12;
   const double load_Nm = loaded ? (s_.force_true_kN + s_.friction_kN) * Nm_per_kN_ : 0.0;
   const double v = s_.speed_rev_per_s;
-  const double drive_friction_Nm = t.coulomb_friction_Nm * std::tanh(v / t.coulomb_smoothing_rev_per_s) +
-                                   t.viscous_friction_Nm_per_rev_per_s * v;
   const double accel_rev_s2 =
-      (torque_scale * torque_per_A_Nm_ * s_.current_A - load_Nm - drive_friction_Nm) / (inertia_kg_m2_ * kTwoPi);
+      (torque_scale * torque_per_A_Nm_ * s_.current_A - load_Nm - drive_friction_Nm(t, v)) / (inertia_kg_m2_ * kTwoPi);
   // Semi-implicit Euler: speed first, then position with the new speed.
   s_.speed_rev_per_s = seized ? 0.0 : s_.speed_rev_per_s + h_s * accel_rev_s2;
   s_.motor_position_rev += h_s * s_.speed_rev_per_s;

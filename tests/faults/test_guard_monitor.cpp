@@ -478,8 +478,7 @@ TEST(FaultMonitor, ATorqueLossIsNamedDuringAnApplyBelowTheHoldChecksLoad) {
   SampleCheck ok;
   auto run = [&](const MonitorParams& p, double fraction, double speed_rev_per_s, double true_kN, double lc_kN) {
     FaultMonitor m(p, Target::FL);
-    const double friction_Nm = p.drive_friction_Nm * std::tanh(speed_rev_per_s / p.drive_friction_smoothing_rev_per_s) +
-                               p.drive_viscous_Nm_per_rev_per_s * speed_rev_per_s;
+    const double friction_Nm = bbw::plant::drive_friction_Nm(p.drive, speed_rev_per_s);
     for (int k = 1; k < 200; ++k) {
       const double t = 0.001 * k;
       const double rise_kN = 2.0 * speed_rev_per_s * t;  // 2 kN/rev

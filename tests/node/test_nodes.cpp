@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "alloc_counter.hpp"
 #include "bbw/faults/schedule_yaml.hpp"
+#include "bbw/node/ccu_core.hpp"
 #include "bbw/node/ccu_node.hpp"
 #include "bbw/node/corner_node.hpp"
 #include "node_test_support.hpp"
@@ -209,6 +212,25 @@ TEST(CcuNode, CommandsCarryTheCalibratorsFrictionEstimate) {
 // After a warm-up that reaches the first accepted fits, a period of the CCU node and four corner
 // nodes (commands, plant steps, blocks, calibrator, fault monitor, calibration states) allocates
 // nothing. Counted with a replaced operator new (tests/support/alloc_counter).
+// The CCU judges the corners' actuator-test pulses from a history of a few samples: a scenario
+// whose pulse spans more samples than it holds is refused with the keys named, not run with the
+// test silently unjudged.
+TEST(CcuCore, RefusesATestPulseLongerThanTheMonitorJudges) {
+  auto fs = load("config/scenarios/faults/actuator_seized_in_hold.yaml");
+  EXPECT_NO_THROW(bbw::ccu::monitor_params_for(fs.scenario));
+  fs.scenario.plant_dt_s = 0.0001;  // 3 ms is 30 samples
+  try {
+    bbw::ccu::monitor_params_for(fs.scenario);
+    ADD_FAILURE() << "a 30-sample pulse was accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("controller.hold_test_pulse_s"), std::string::npos) << what;
+    EXPECT_NE(what.find("plant_dt_s"), std::string::npos) << what;
+  }
+  fs.scenario.controller.hold_test_current_A = 0.0;  // no test: nothing to judge
+  EXPECT_NO_THROW(bbw::ccu::monitor_params_for(fs.scenario));
+}
+
 TEST(NodeAllocation, NoHeapAllocationPerPeriodOnceRunning) {
   const auto fs = load("config/scenarios/four_corner_rig.yaml");
   CcuNode ccu(fs.scenario, test::robust_config(), true);

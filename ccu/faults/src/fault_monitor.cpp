@@ -91,8 +91,11 @@ void MonitorParams::validate() const {
   require(torque_lost_threshold > 0.0 && torque_lost_threshold < torque_fraction_threshold, "torque_lost_threshold",
           torque_lost_threshold, "must be in (0, torque_fraction_threshold)");
   positive("torque_lost_persist_s", torque_lost_persist_s);
-  require(std::isfinite(drive_friction_Nm) && drive_friction_Nm >= 0.0, "drive_friction_Nm", drive_friction_Nm,
-          "must be >= 0");
+  require(std::isfinite(drive.coulomb_friction_Nm) && drive.coulomb_friction_Nm >= 0.0, "drive.coulomb_friction_Nm",
+          drive.coulomb_friction_Nm, "must be >= 0");
+  positive("drive.coulomb_smoothing_rev_per_s", drive.coulomb_smoothing_rev_per_s);
+  require(std::isfinite(drive.viscous_friction_Nm_per_rev_per_s) && drive.viscous_friction_Nm_per_rev_per_s >= 0.0,
+          "drive.viscous_friction_Nm_per_rev_per_s", drive.viscous_friction_Nm_per_rev_per_s, "must be >= 0");
   positive("unexplained_margin_Nm", unexplained_margin_Nm);
   require(std::isfinite(unexplained_relative) && unexplained_relative >= 0.0, "unexplained_relative",
           unexplained_relative, "must be >= 0");
@@ -115,9 +118,6 @@ void MonitorParams::validate() const {
   require(std::isfinite(torque_check_moving_min_speed_rev_per_s) && torque_check_moving_min_speed_rev_per_s >= 0.0,
           "torque_check_moving_min_speed_rev_per_s", torque_check_moving_min_speed_rev_per_s, "must be >= 0");
   positive("torque_check_moving_min_load_kN", torque_check_moving_min_load_kN);
-  positive("drive_friction_smoothing_rev_per_s", drive_friction_smoothing_rev_per_s);
-  require(std::isfinite(drive_viscous_Nm_per_rev_per_s) && drive_viscous_Nm_per_rev_per_s >= 0.0,
-          "drive_viscous_Nm_per_rev_per_s", drive_viscous_Nm_per_rev_per_s, "must be >= 0");
   positive("torque_persist_s", torque_persist_s);
   positive("tracking_time_constant_s", tracking_time_constant_s);
   positive("tracking_threshold_kN", tracking_threshold_kN);

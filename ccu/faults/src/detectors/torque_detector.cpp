@@ -27,8 +27,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   constexpr double kTwoPi = 6.283185307179586;
   const double need = load_kN * p.Nm_per_kN + p.inertia_kg_m2 * kTwoPi * accel;
   const double make = r.motor_current_A * p.torque_per_A_Nm;
-  const double drive_friction = p.drive_friction_Nm * std::tanh(r.speed_rev_per_s / p.drive_friction_smoothing_rev_per_s) +
-                                p.drive_viscous_Nm_per_rev_per_s * r.speed_rev_per_s;
+  const double drive_friction = plant::drive_friction_Nm(p.drive, r.speed_rev_per_s);
   if (!torque_init_ || c.dt_s <= 0.0) {
     torque_init_ = true;
     need_Nm_ = need;
@@ -86,7 +85,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
     need_lo_Nm_ += (lo - need_lo_Nm_) * k;
   }
   const double load_Nm = std::max(std::abs(load_hi_kN), std::abs(load_lo_kN)) * p.Nm_per_kN;
-  const double band = p.drive_friction_Nm + p.unexplained_margin_Nm + p.unexplained_relative * load_Nm;
+  const double band = p.drive.coulomb_friction_Nm + p.unexplained_margin_Nm + p.unexplained_relative * load_Nm;
   excess_Nm_ = make_Nm_ - need_hi_Nm_;
   const bool slow = std::abs(r.speed_rev_per_s) <= p.unexplained_max_speed_rev_per_s;
   // Seized in a hold: stopped where it is, the force where it is commanded, and still the made
@@ -110,7 +109,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // Pushing: beyond the band and less than the lost threshold of it needed (a partial torque
   // loss the loop absorbs is not a lost actuator), or winding up against a seized drive.
   const bool pushing = make_Nm_ - need_hi_Nm_ > band &&
-                       (need_hi_Nm_ + p.drive_friction_Nm < p.torque_lost_threshold * make_Nm_ || winding_up);
+                       (need_hi_Nm_ + p.drive.coulomb_friction_Nm < p.torque_lost_threshold * make_Nm_ || winding_up);
   // Pulling: beyond the band plus the whole load (a gear in its backlash gap carries none of it).
   const bool pulling = need_lo_Nm_ - make_Nm_ > band + load_Nm;
   if (slow && (pushing || pulling)) {
@@ -141,7 +140,7 @@ void TorqueDetector::update_response(const SampleContext& c, const MonitorParams
   const bool even = c.have_prev && c.dt_s > 0.0 && (response_count_ == 0 || std::abs(c.dt_s - response_dt_s_) <= 0.25 * response_dt_s_);
   if (!even || !std::isfinite(r.motor_current_A) || !std::isfinite(r.speed_rev_per_s)) response_count_ = 0;
   if (c.dt_s > 0.0) response_dt_s_ = c.dt_s;
-  const int size = kMaxResponseWindow + 1;
+  const int size = kHistory;
   response_head_ = (response_head_ + 1) % size;
   response_speed_[static_cast<std::size_t>(response_head_)] = r.speed_rev_per_s;
   response_current_[static_cast<std::size_t>(response_head_)] = r.motor_current_A;

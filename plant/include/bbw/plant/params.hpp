@@ -3,6 +3,7 @@
 // config/plant/ecaliper.yaml and describe one plausible e-caliper; docs/plant.md explains each.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 namespace bbw::plant {
@@ -26,6 +27,13 @@ struct TransmissionParams {
   double coulomb_smoothing_rev_per_s = 0.2;     // speed at which tanh() reaches 76 % of it
   double viscous_friction_Nm_per_rev_per_s = 0.002;
 };
+
+// The drive's friction torque at the spindle at `speed_rev_per_s`: smoothed Coulomb plus viscous
+// (the plant's, and the fault monitor's model of it).
+inline double drive_friction_Nm(const TransmissionParams& t, double speed_rev_per_s) {
+  return t.coulomb_friction_Nm * std::tanh(speed_rev_per_s / t.coulomb_smoothing_rev_per_s) +
+         t.viscous_friction_Nm_per_rev_per_s * speed_rev_per_s;
+}
 
 // True clamp force versus actuator position (the characteristic curve):
 //   delta   = x - x_contact(T, wear)

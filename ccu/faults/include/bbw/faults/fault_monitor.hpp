@@ -195,13 +195,11 @@ struct MonitorParams {
   double torque_lost_persist_s = 0.015;
   // Unexplained torque (issue 14: a seized drive or a motor that makes no torque, at any load):
   // near standstill, the measured current's torque against what the load, the acceleration and
-  // the drive's friction need. Pushing: make - need > drive_friction_Nm + unexplained_margin_Nm
+  // the drive's friction need. Pushing: make - need > drive.coulomb_friction_Nm + unexplained_margin_Nm
   // + unexplained_relative |need|. Pulling: need - make > the same + |need| (a gear in its
   // backlash gap carries none of the load the load cell reads). For unexplained_persist_s:
   // ActuatorLost.
-  double drive_friction_Nm = 0.05;            // the drive's Coulomb friction at the spindle (the plant's transmission)
-  double drive_friction_smoothing_rev_per_s = 0.2;  // its tanh smoothing speed (the plant's transmission)
-  double drive_viscous_Nm_per_rev_per_s = 0.002;    // the drive's viscous friction (the plant's transmission)
+  plant::TransmissionParams drive;            // the drive's friction (the plant's transmission: plant::drive_friction_Nm)
   double unexplained_margin_Nm = 0.1;
   double unexplained_relative = 0.3;
   double unexplained_max_speed_rev_per_s = 2.0;

@@ -26,7 +26,9 @@ class TorqueDetector {
   explicit TorqueDetector(const MonitorParams& p);
   // `load_kN`: the load cell while it is trusted (`load_cell_load`), else the CCU's force estimate.
   void update(const SampleContext& c, double load_kN, bool load_cell_load, const MonitorParams& p, DiagnosisArbiter& a);
-  static constexpr int kMaxResponseWindow = 16;
+  // The longest test pulse half the history holds, in samples (two halves and the samples before).
+  static constexpr int kMaxPulseSamples = 7;
+  static constexpr int kHistory = 2 * kMaxPulseSamples + 2;
   void on_rejoin() {
     torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = static_init_ = false;
     speed_repeats_ = 0;
@@ -61,8 +63,8 @@ class TorqueDetector {
     unanswered_ = 0;
   }
   void update_response(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a);
-  std::array<double, kMaxResponseWindow + 1> response_speed_{};
-  std::array<double, kMaxResponseWindow + 1> response_current_{};
+  std::array<double, kHistory> response_speed_{};
+  std::array<double, kHistory> response_current_{};
   int response_count_ = 0;  // consecutive samples held (up to the array's size)
   double response_dt_s_ = 0.0;  // their spacing
   int response_head_ = 0;
