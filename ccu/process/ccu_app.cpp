@@ -291,6 +291,16 @@ void CcuApp::drain_blocks_in_order(double arrival_s, std::uint64_t step) {
     transport::EndpointId writer = 0;
     while (blocks_[i]->take(block_, writer)) {
       if (block_.corner_id() == node_.channel(i).slot) instances_[i] = blocks_[i]->last_info().instance_handle;
+      // A corner's blocks come from one reliable writer, in order: a jump means the blocks between
+      // are gone for good (this CCU was cut off longer than the corner's measurement history or
+      // its discovery lease), and it could only wait for them until the peer timeout. Not with a
+      // scheduled corner restart (a new writer that resumes at its own period).
+      if (s.last_seq && block_.block_seq() > *s.last_seq + 1 && restarts_.empty() && !fell_out_) {
+        fell_out_ = true;
+        fell_out_why_ = "blocks " + std::to_string(*s.last_seq + 1) + "-" + std::to_string(block_.block_seq() - 1) + " of " +
+                        std::string(corner_name(node_.channel(i).corner)) + " never arrived";
+      }
+      if (!s.last_seq || block_.block_seq() > *s.last_seq) s.last_seq = block_.block_seq();
       if (block_.block_seq() <= step && s.count == 0) {
         process(block_, writer);
       } else if (s.count < s.slots.size()) {
@@ -300,6 +310,10 @@ void CcuApp::drain_blocks_in_order(double arrival_s, std::uint64_t step) {
         ++s.count;
       } else {
         ++stash_overflows_;  // further behind than the stash holds: the block is lost to this CCU
+        if (!fell_out_) {
+          fell_out_ = true;
+          fell_out_why_ = "more than " + std::to_string(s.slots.size()) + " periods behind " + std::string(corner_name(node_.channel(i).corner));
+        }
       }
     }
   }
@@ -444,27 +458,23 @@ int CcuApp::run(std::string& error) {
         drain_vehicle();
         drain_health();
         drain_qos_events(t_end, true);
-        return node_.period_complete(k);
+        return fell_out_ || node_.period_complete(k);
       };
-      last_wake_ = Clock::now();
       const runtime::PeriodStart begun = clock->begin(k, pred, [&] {
-        // A standby run: no block from any corner for kCutOff_s of wall time while waiting, while
-        // this CCU itself woke on time (every kStandbyResend), is a cut link (the corners go on
-        // under the other CCU). A CCU starved of the CPU wakes late and sees the same silence:
-        // that is no cut (as in realtime, `ran_on_time`). Who leads never changes a lockstep log
-        // (both CCUs compute the same commands), so a slow machine mistaken for a cut costs
-        // nothing but the order of the two CCUs.
-        const auto now = Clock::now();
-        if (now - last_wake_ > 2.5 * kStandbyResend) last_stall_at_ = now;
-        last_wake_ = now;
-        const bool ran_on_time = std::chrono::duration<double>(now - last_stall_at_).count() > kCutOff_s;
-        if (options_.standby && !cut_off_ && ran_on_time && last_block_at_ != Clock::time_point{} &&
-            std::chrono::duration<double>(now - last_block_at_).count() > kCutOff_s) {
-          demote(t_k, "cut off from every corner");
-          cut_off_ = true;
-        }
+        // No wall-time judgement in lockstep: a silence is not taken for a cut (a loaded machine
+        // silences the corners just as well: under six busy loops a standby took 32-60 silences
+        // of 50 ms for cuts in 2 of 3 runs and handed the corners to a primary still catching
+        // up). Both CCUs' grants are the same, so who leads changes no log; a CCU whose link
+        // returns catches up from the repaired blocks, or leaves the run if blocks are gone.
         send_commands(k, false, false);
       });
+      if (fell_out_) {
+        std::cout << "bbw_ccu (" << options_.role << "): " << fell_out_why_ << ": it cannot rejoin the lock step and leaves the run at "
+                  << t_k << " s" << std::endl;
+        failover_.demote_reason = "left the lock step";
+        retired = true;
+        break;
+      }
       const bool ok = begun == runtime::PeriodStart::Go;
       if (const std::string failed = node_.end_lockstep_period(k, t_end); !failed.empty()) {
         error = "corner " + failed + " reported failure at period " + std::to_string(k);

@@ -128,9 +128,8 @@ class CcuApp {
   runtime::CcuFailoverStats failover_;                    // a standby run: role, strength, failure
   std::chrono::steady_clock::time_point last_send_{};     // realtime, standby run: the last command send
   std::chrono::steady_clock::time_point last_block_at_{}; // ... and the last block from any corner
-  bool cut_off_ = false;                                  // no block from any corner for kCutOff_s
-  std::chrono::steady_clock::time_point last_stall_at_{}; // its own last stall (realtime: a late send; lockstep: a late wake)
-  std::chrono::steady_clock::time_point last_wake_{};     // lockstep, standby run: the last wake while waiting
+  bool cut_off_ = false;                                  // realtime: no block from any corner for kCutOff_s
+  std::chrono::steady_clock::time_point last_stall_at_{}; // realtime: its own last stall (a late send)
   std::chrono::steady_clock::time_point quiet_until_{};   // back from a long outage: no command until then
   std::uint32_t reannouncements_ = 0;                     // strength announced again after a cut
   // Lockstep with a standby: blocks of later periods than this CCU's, per corner (FIFO ring).
@@ -141,9 +140,12 @@ class CcuApp {
     };
     std::array<Slot, 1024> slots;  // as deep as the measurement history (profile *_lockstep_standby)
     std::size_t head = 0, count = 0;
+    std::optional<std::uint64_t> last_seq;  // the newest block taken from the reader
   };
   std::vector<Stash> stash_;
   std::uint64_t stash_overflows_ = 0;
+  bool fell_out_ = false;     // lockstep, standby run: blocks it needs are gone; it leaves the run
+  std::string fell_out_why_;
   std::vector<std::pair<std::uint64_t, std::size_t>> restarts_;  // lockstep: (step, slot)
   // A vehicle run: the vehicle's and the pedal's readings, their barrier places, the brake functions.
   std::unique_ptr<dds::DdsInlet<msg::VehicleSensorsPubSubType>> vehicle_in_;

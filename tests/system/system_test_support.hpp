@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -43,7 +44,9 @@ class RemoveScratchOnPass : public ::testing::EmptyTestEventListener {
     listener->dirs_.push_back(dir);
   }
   void OnTestEnd(const ::testing::TestInfo& info) override {
-    if (info.result() != nullptr && info.result()->Passed()) {
+    // BBW_KEEP_SCRATCH=1 keeps them also when the test passes (to compare a good run with a bad one).
+    const char* keep = std::getenv("BBW_KEEP_SCRATCH");
+    if (info.result() != nullptr && info.result()->Passed() && (keep == nullptr || std::string(keep) != "1")) {
       for (const auto& d : dirs_) {
         std::error_code ec;
         std::filesystem::remove_all(d, ec);
