@@ -1,6 +1,7 @@
 #include "bbw/runtime/command_owner.hpp"
 
 #include <stdexcept>
+#include <utility>
 
 namespace bbw::runtime {
 
@@ -15,7 +16,13 @@ const char* to_string(CommandRole r) {
 
 CommandOwnerTracker::CommandOwnerTracker(double period_s) : period_s_(period_s) {
   if (!(period_s > 0.0)) throw std::invalid_argument("CommandOwnerTracker: period_s must be > 0");
-  stats_.switches.reserve(kMaxSwitches);
+  stats_.switches.reserve(kKeepFirst);
+}
+
+CornerFailoverStats CommandOwnerTracker::stats() const {
+  CornerFailoverStats s = stats_;
+  for (std::size_t i = 0; i < last_count_; ++i) s.switches.push_back(last_[(last_head_ + i) % kKeepLast]);
+  return s;
 }
 
 void CommandOwnerTracker::on_command(CommandRole role, std::uint64_t step, double sim_s, double mono_s) {
@@ -25,11 +32,16 @@ void CommandOwnerTracker::on_command(CommandRole role, std::uint64_t step, doubl
     case CommandRole::Unknown: ++stats_.commands_unknown; break;
   }
   if (!have_ || role != owner_) {
-    if (stats_.switches.size() < kMaxSwitches) {
-      stats_.switches.push_back({have_ ? to_string(owner_) : "none", to_string(role), step, sim_s, mono_s,
-                                 have_ ? 1e3 * (mono_s - last_mono_s_) : 0.0});
+    OwnerSwitch x{have_ ? to_string(owner_) : "none", to_string(role), step, sim_s, mono_s,
+                  have_ ? 1e3 * (mono_s - last_mono_s_) : 0.0};
+    if (stats_.switches.size() < kKeepFirst) {
+      stats_.switches.push_back(std::move(x));
+    } else if (last_count_ < kKeepLast) {
+      last_[(last_head_ + last_count_++) % kKeepLast] = std::move(x);
     } else {
-      ++dropped_;
+      last_[last_head_] = std::move(x);  // the oldest of the ring goes
+      last_head_ = (last_head_ + 1) % kKeepLast;
+      ++stats_.switches_dropped;
     }
   }
   if (have_) {

@@ -150,6 +150,7 @@ std::string to_text(const CornerFailoverStats& s) {
   Writer w;
   corner_fields(s, w);
   w("switches", static_cast<std::uint64_t>(s.switches.size()));
+  w("switches_dropped", s.switches_dropped);
   for (std::size_t i = 0; i < s.switches.size(); ++i) {
     const OwnerSwitch& x = s.switches[i];
     const std::string p = "switch" + std::to_string(i) + ".";
@@ -191,6 +192,7 @@ CornerFailoverStats parse_corner_failover(const std::string& text, const std::st
   corner_fields(s, r);
   std::uint64_t n = 0;
   r("switches", n);
+  r("switches_dropped", s.switches_dropped);
   for (std::uint64_t i = 0; i < n; ++i) {
     const std::string p = "switch" + std::to_string(i) + ".";
     OwnerSwitch x;

@@ -165,6 +165,49 @@ TEST(FailoverSummary, TakeoverGapDipAndOwners) {
   EXPECT_DOUBLE_EQ(ls.max_command_gap_ms, 5.0);
 }
 
+// A loaded lockstep run flaps hundreds of times before the failure: each corner keeps its first
+// changes of owner and its latest (the takeover among them) and counts those between; the summary
+// still finds the takeover and counts every change before the failure. (With only the first 64
+// kept, a secure lockstep kill run under six busy loops reported its takeover missing.)
+TEST(FailoverSummary, OwnershipFlappingBeforeTheFailureKeepsTheTakeover) {
+  using T = runtime::CommandOwnerTracker;
+  auto flapping = [](const std::string& corner, int flaps, double takeover_mono_s) {
+    T t(0.005);
+    std::uint64_t k = 0;
+    for (int i = 0; i < flaps; ++i, ++k) {
+      t.on_command(i % 2 == 0 ? CommandRole::Primary : CommandRole::Standby, k, 0.005 * k, 100.0 + 0.001 * k);
+    }
+    t.on_command(CommandRole::Primary, k, 0.005 * k, 100.0 + 0.001 * k);  // the primary owns it at the failure
+    t.on_command(CommandRole::Standby, 702, 3.51, takeover_mono_s);      // the takeover
+    auto st = t.stats();
+    st.corner = corner;
+    return runtime::parse_corner_failover(runtime::to_text(st), corner + ".stats");  // as the launcher reads it
+  };
+  Synthetic s;  // the primary fails at 103.5 s (monotonic)
+  const int flaps = 300;
+  for (std::size_t i = 0; i < 4; ++i) s.in.corners[i].owners = flapping(s.in.corners[i].owners.corner, flaps, 103.5 + 0.004 * (i + 1));
+  const auto& fl = s.in.corners[0].owners;
+  ASSERT_EQ(fl.switches.size(), T::kKeepFirst + T::kKeepLast);
+  EXPECT_EQ(fl.switches_dropped, static_cast<std::uint64_t>(flaps + 2) - T::kKeepFirst - T::kKeepLast);  // none->primary ... ->standby
+  for (std::size_t j = 1; j < fl.switches.size(); ++j) EXPECT_LT(fl.switches[j - 1].step, fl.switches[j].step) << j;
+  const auto r = launch::assess_failover(s.in);
+  EXPECT_EQ(r.takeover_missing, "");
+  EXPECT_NEAR(r.takeover_ms, 16.0, 1e-6);
+  EXPECT_EQ(r.switches_before_failure, 4 * flaps);  // all but the start's first change, per corner
+  EXPECT_EQ(r.switches_after_failure, 4);
+  EXPECT_EQ(r.owners_at_end, "standby,standby,standby,standby");
+  // Flapping on after the failure too, beyond what is kept: who owned RL at the failure is not
+  // known, and the summary says so instead of guessing.
+  Synthetic late;
+  for (std::size_t i = 0; i < 4; ++i) late.in.corners[i].owners = flapping(late.in.corners[i].owners.corner, 200, 103.5 + 0.004 * (i + 1));
+  auto& rl = late.in.corners[2].owners;
+  for (auto& x : rl.switches) x.mono_s += 3.4;  // every kept change but the first 32 now after the failure
+  for (std::size_t j = 0; j < T::kKeepFirst; ++j) rl.switches[j].mono_s -= 3.4;
+  const auto lr = launch::assess_failover(late.in);
+  EXPECT_NE(lr.takeover_missing.find("RL ("), std::string::npos) << lr.takeover_missing;
+  EXPECT_NE(lr.takeover_missing.find("not kept"), std::string::npos) << lr.takeover_missing;
+}
+
 TEST(LaunchOutDir, AStandbyRunsFilesAreOwnAndCleared) {
   namespace fs = std::filesystem;
   const fs::path d = fs::temp_directory_path() / ("bbw_failover_parts_" + std::to_string(::getpid()));

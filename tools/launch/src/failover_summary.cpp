@@ -1,5 +1,7 @@
 #include "failover_summary.hpp"
 
+#include "bbw/runtime/command_owner.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,6 +9,7 @@
 
 #include "bbw/common/csv.hpp"
 #include "bbw/node/command_plan.hpp"
+#include "bbw/runtime/command_owner.hpp"
 #include "bbw/runtime/run_stats.hpp"
 
 namespace bbw::launch {
@@ -95,8 +98,17 @@ FailoverResult assess_failover(const FailoverInput& in) {
       r.safe_state_entered = true;
       r.safe_state_s = r.safe_state_s < 0.0 ? c.ccu_lost_s : std::min(r.safe_state_s, c.ccu_lost_s);
     }
+    // Changes the corner did not keep lie between the first kKeepFirst and the rest.
+    const std::size_t gap_at = c.owners.switches_dropped > 0 ? runtime::CommandOwnerTracker::kKeepFirst : sw.size();
     if (failed_mono < 0.0) {
       for (const auto& x : sw) r.switches_before_failure += x.step > sw.front().step ? 1 : 0;
+      r.switches_before_failure += static_cast<int>(c.owners.switches_dropped);
+      continue;
+    }
+    if (gap_at < sw.size() && sw[gap_at].mono_s >= failed_mono) {
+      // The changes around the failure were not kept: who owned the corner then is unknown.
+      r.takeover_missing += (r.takeover_missing.empty() ? "" : ", ") + c.owners.corner + " (" +
+                            std::to_string(c.owners.switches_dropped) + " changes of owner around the failure not kept)";
       continue;
     }
     // The owner at the failure, the switches before and after it.
@@ -106,6 +118,7 @@ FailoverResult assess_failover(const FailoverInput& in) {
       if (sw[k].mono_s < failed_mono) {
         owner_at_failure = sw[k].to;
         if (sw[k].step > sw.front().step) ++r.switches_before_failure;  // not the start's settling
+        if (k == gap_at) r.switches_before_failure += static_cast<int>(c.owners.switches_dropped);
         continue;
       }
       ++r.switches_after_failure;

@@ -65,6 +65,8 @@ struct CornerFailoverStats {
   double max_gap_sim_at_s = -1.0;
   double last_command_mono_s = -1.0;
   std::vector<OwnerSwitch> switches;    // in order; the first is none -> the first owner
+  // Changes not kept, all between switches[CommandOwnerTracker::kKeepFirst - 1] and the next.
+  std::uint64_t switches_dropped = 0;
 };
 
 std::string to_text(const CcuFailoverStats& s);
