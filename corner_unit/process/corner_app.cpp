@@ -76,7 +76,7 @@ CornerApp::CornerApp(const scenario::Scenario& scenario, const CornerOptions& op
                 dds::Partition{own_partition(options)}),
       calibration_(participant_, dds::kCalibrationTopic, "state_reader", events,
                    dds::Partition{dds::run_partition(options.participant.run_id)}),
-      owners_(scenario.ccu_period_s) {
+      owners_(scenario.ccu_period_s, options.mode == ClockMode::Lockstep) {
   if (options.vehicle) {
     vehicle_in_ = std::make_unique<dds::DdsInlet<msg::CaliperTemperaturesPubSubType>>(
         participant_, dds::kCaliperTemperatureTopic, dds::profiles_for(true).measurement_reader, events,

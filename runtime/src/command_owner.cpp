@@ -14,7 +14,7 @@ const char* to_string(CommandRole r) {
   return "unknown";
 }
 
-CommandOwnerTracker::CommandOwnerTracker(double period_s) : period_s_(period_s) {
+CommandOwnerTracker::CommandOwnerTracker(double period_s, bool lockstep) : period_s_(period_s), lockstep_(lockstep) {
   if (!(period_s > 0.0)) throw std::invalid_argument("CommandOwnerTracker: period_s must be > 0");
   stats_.switches.reserve(kKeepFirst);
 }
@@ -31,6 +31,7 @@ void CommandOwnerTracker::on_command(CommandRole role, std::uint64_t step, doubl
     case CommandRole::Standby: ++stats_.commands_standby; break;
     case CommandRole::Unknown: ++stats_.commands_unknown; break;
   }
+  if (have_ && lockstep_ && step <= last_step_) return;  // a repeated grant: counted above, no change
   if (!have_ || role != owner_) {
     OwnerSwitch x{have_ ? to_string(owner_) : "none", to_string(role), step, sim_s, mono_s,
                   have_ ? 1e3 * (mono_s - last_mono_s_) : 0.0};

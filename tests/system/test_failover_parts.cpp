@@ -46,6 +46,18 @@ TEST(CommandOwnerTracker, RecordsChangesOfWriterAndTheLongestGaps) {
   EXPECT_DOUBLE_EQ(s.max_gap_mono_at_sim_s, 0.065);
   EXPECT_NEAR(s.max_gap_sim_ms, 15.0, 1e-9);  // three periods
   EXPECT_THROW(runtime::CommandOwnerTracker(0.0), std::invalid_argument);
+  // Lockstep: the standby's repeat of a period the corner has done (taken again after the
+  // primary was killed at its next period) is counted, but the takeover is its first new grant.
+  runtime::CommandOwnerTracker l(0.005, true);
+  for (std::uint64_t k = 0; k < 700; ++k) l.on_command(CommandRole::Primary, k, 0.005 * k, 100.0 + 0.001 * k);
+  l.on_command(CommandRole::Standby, 699, 3.495, 100.754);  // a repeat, 54 ms after the last grant
+  l.on_command(CommandRole::Standby, 700, 3.5, 100.756);
+  const auto ls = l.stats();
+  EXPECT_EQ(ls.commands_standby, 2u);
+  ASSERT_EQ(ls.switches.size(), 2u);
+  EXPECT_EQ(ls.switches[1].step, 700u);
+  EXPECT_NEAR(ls.switches[1].gap_ms, 57.0, 1e-6);
+  EXPECT_NEAR(ls.max_gap_sim_ms, 5.0, 1e-9);
 }
 
 TEST(FailoverStats, RoundTripAndNameWhatIsWrong) {

@@ -23,7 +23,13 @@ class CommandOwnerTracker {
  public:
   static constexpr std::size_t kKeepFirst = 32;
   static constexpr std::size_t kKeepLast = 96;
-  explicit CommandOwnerTracker(double period_s);
+  // lockstep: a command for a period not after the latest one taken repeats a grant the corner
+  // already obeyed (the two CCUs' grants are the same; a corner takes it again, harmlessly): it is
+  // counted by its writer's role but is no change of owner. (Counted as one, the standby's repeat
+  // of period 699, taken 54 ms after the primary was killed at its period 700, gave a takeover
+  // 5 ms before the failure.) Realtime: a takeover's command may name an earlier period (the two
+  // CCUs' clocks start apart), so every change of writer is one.
+  explicit CommandOwnerTracker(double period_s, bool lockstep = false);
 
   // A command for period `step` (starting at `sim_s`) from `role`, taken at `mono_s`.
   void on_command(CommandRole role, std::uint64_t step, double sim_s, double mono_s);
@@ -35,6 +41,7 @@ class CommandOwnerTracker {
 
  private:
   double period_s_;
+  bool lockstep_;
   CornerFailoverStats stats_;
   bool have_ = false;
   CommandRole owner_ = CommandRole::Unknown;
