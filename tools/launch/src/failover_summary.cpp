@@ -1,7 +1,5 @@
 #include "failover_summary.hpp"
 
-#include "bbw/runtime/command_owner.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -105,12 +103,8 @@ FailoverResult assess_failover(const FailoverInput& in) {
       r.switches_before_failure += static_cast<int>(c.owners.switches_dropped);
       continue;
     }
-    if (gap_at < sw.size() && sw[gap_at].mono_s >= failed_mono) {
-      // The changes around the failure were not kept: who owned the corner then is unknown.
-      r.takeover_missing += (r.takeover_missing.empty() ? "" : ", ") + c.owners.corner + " (" +
-                            std::to_string(c.owners.switches_dropped) + " changes of owner around the failure not kept)";
-      continue;
-    }
+    // The changes around the failure were not kept: who owned the corner then is unknown.
+    const bool owner_unknown = gap_at < sw.size() && sw[gap_at - 1].mono_s < failed_mono && sw[gap_at].mono_s >= failed_mono;
     // The owner at the failure, the switches before and after it.
     std::string owner_at_failure = "none";
     const runtime::OwnerSwitch* takeover = nullptr;
@@ -122,10 +116,14 @@ FailoverResult assess_failover(const FailoverInput& in) {
         continue;
       }
       ++r.switches_after_failure;
+      if (k == gap_at) r.switches_after_failure += static_cast<int>(c.owners.switches_dropped);
       if (sw[k].to == "primary") ++r.switches_back_to_primary;
       if (takeover == nullptr && sw[k].to == "standby") takeover = &sw[k];
     }
-    if (owner_at_failure == "standby") {
+    if (owner_unknown) {
+      r.takeover_missing += (r.takeover_missing.empty() ? "" : ", ") + c.owners.corner + " (" +
+                            std::to_string(c.owners.switches_dropped) + " changes of owner around the failure not kept)";
+    } else if (owner_at_failure == "standby") {
       ++r.corners_already_on_standby;
     } else if (takeover != nullptr) {
       takeover_mono = std::max(takeover_mono, takeover->mono_s);

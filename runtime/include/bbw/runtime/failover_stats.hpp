@@ -37,7 +37,7 @@ struct CcuFailoverStats {
   std::vector<StallInterval> stall_intervals;  // the first kMaxStallIntervals of them, in order
   double demoted_sim_s = -1.0;       // the last time it did (-1: never)
   double demoted_mono_s = -1.0;
-  std::string demote_reason;         // the last reason: "" | resumed after a stop | cut off from every corner
+  std::string demote_reason;         // the last reason: "" | resumed after a stop | cut off from every corner (realtime) | left the lock step
   std::uint64_t periods_done = 0;
   double t0_mono_s = -1.0;           // realtime: when its simulated time was 0 (its clock's start)
 };
