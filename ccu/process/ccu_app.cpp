@@ -294,13 +294,15 @@ void CcuApp::drain_blocks_in_order(double arrival_s, std::uint64_t step) {
       // A corner's blocks come from one reliable writer, in order: a jump means the blocks between
       // are gone for good (this CCU was cut off longer than the corner's measurement history or
       // its discovery lease), and it could only wait for them until the peer timeout. Not with a
-      // scheduled corner restart (a new writer that resumes at its own period).
-      if (s.last_seq && block_.block_seq() > *s.last_seq + 1 && restarts_.empty() && !fell_out_) {
+      // scheduled corner restart (a new writer that resumes at its own period), and only for the
+      // channel's own corner of this run (anything else is dropped by the node unread).
+      const bool own = block_.corner_id() == node_.channel(i).slot && block_.run_id() == options_.participant.run_id;
+      if (own && s.last_seq && block_.block_seq() > *s.last_seq + 1 && restarts_.empty() && !fell_out_) {
         fell_out_ = true;
         fell_out_why_ = "blocks " + std::to_string(*s.last_seq + 1) + "-" + std::to_string(block_.block_seq() - 1) + " of " +
                         std::string(corner_name(node_.channel(i).corner)) + " never arrived";
       }
-      if (!s.last_seq || block_.block_seq() > *s.last_seq) s.last_seq = block_.block_seq();
+      if (own && (!s.last_seq || block_.block_seq() > *s.last_seq)) s.last_seq = block_.block_seq();
       if (block_.block_seq() <= step && s.count == 0) {
         process(block_, writer);
       } else if (s.count < s.slots.size()) {
