@@ -48,16 +48,25 @@ ProcessRun run(const std::string& name, const std::vector<std::string>& argv, co
   return bbw::system_test::run(name, argv, dir, limit, {"BBW_DDS_LOG=warning"});
 }
 
-std::vector<std::string> launch_argv(const std::string& dir, int domain, const std::string& mode, bool secure) {
-  std::vector<std::string> a{bin("bbw_launch"), src("tests/system/data/short_rig.yaml"), "--out", dir + "/out",
-                             "--mode", mode, "--domain", std::to_string(domain), "--discovery-timeout", "20",
-                             "--no-report"};
+// realtime_priority: the run under SCHED_FIFO 10 (chrt, inherited by every process and thread
+// of the run) when the test runs as root, as a brake controller runs and as the failover tests
+// run theirs (test_failover_runs.cpp says why): a wall-clock criterion then judges the run, not
+// the rest of the machine's load.
+std::vector<std::string> launch_argv(const std::string& dir, int domain, const std::string& mode, bool secure,
+                                     bool realtime_priority = false) {
+  std::vector<std::string> a;
+  if (realtime_priority && ::geteuid() == 0 && ::access("/usr/bin/chrt", X_OK) == 0) a = {"/usr/bin/chrt", "-f", "10"};
+  for (const std::string& x : {bin("bbw_launch"), src("tests/system/data/short_rig.yaml"), std::string("--out"), dir + "/out",
+                               std::string("--mode"), mode, std::string("--domain"), std::to_string(domain),
+                               std::string("--discovery-timeout"), std::string("20"), std::string("--no-report")}) {
+    a.push_back(x);
+  }
   if (secure) a.insert(a.end(), {"--secure", "--keys", dir + "/keys"});
   return a;
 }
 
-ProcessRun launch(const std::string& dir, int domain, const std::string& mode, bool secure) {
-  return run("bbw_launch", launch_argv(dir, domain, mode, secure), dir, 150s);
+ProcessRun launch(const std::string& dir, int domain, const std::string& mode, bool secure, bool realtime_priority = false) {
+  return run("bbw_launch", launch_argv(dir, domain, mode, secure, realtime_priority), dir, 150s);
 }
 
 // Lines in a file so far (0 when it does not exist).
@@ -72,8 +81,8 @@ ProcessRun launch(const std::string& dir, int domain, const std::string& mode, b
 // A launcher started now; intruders that know its run id (issue 17: runs have their own DDS
 // partitions, so an intruder must know the run id to reach it) start once it is printed.
 [[maybe_unused]] std::unique_ptr<Launch> start_launch(const std::string& dir, int domain, const std::string& mode,
-                                                      bool secure) {
-  return std::make_unique<Launch>(dir, "bbw_launch", launch_argv(dir, domain, mode, secure),
+                                                      bool secure, bool realtime_priority = false) {
+  return std::make_unique<Launch>(dir, "bbw_launch", launch_argv(dir, domain, mode, secure, realtime_priority),
                                   std::vector<std::string>{"BBW_DDS_LOG=warning"});
 }
 
@@ -336,9 +345,14 @@ TEST(SystemHostileInput, MalformedMeasurementsAreRejectedAndCounted) {
 // missed on FR, RL, RR) and the CCU receives every one of their blocks in order, while it did
 // receive at least 10 times FL's normal number of blocks.
 TEST(SystemHostileInput, AFloodingCornerDoesNotDelayTheOthersCommands) {
-  // The flooder runs at nice 19: it stands for another ECU on the network, and on this 2-core
-  // machine it would otherwise take the CPU the corner processes need (CPU exhaustion of the
-  // CCU's host is outside the threat model, docs/security.md). Timing on this shared VM is
+  // The run's processes run under SCHED_FIFO 10 as root (launch_argv): at normal priority the
+  // test failed once while a sanitizer build ran beside it (every judged flooded run had a late
+  // command, the one control run after them none: the build's load, not the flood, decided).
+  // The flooder stands for another ECU on the network: at normal priority beside a run under
+  // SCHED_FIFO (it cannot take the run's CPU then; niced to 19, six busy loops starved it in 18
+  // of 18 runs and nothing could be judged), and at nice 19 beside a run at normal priority
+  // (without root), where it would otherwise take the CPU the corner processes need (CPU
+  // exhaustion of the CCU's host is outside the threat model, docs/security.md). Timing on this shared VM is
   // noisy even without a flood (command deadline misses in 1 of 8 plain realtime runs, jitter
   // up to 22 ms, and such stalls come in bursts), so the deadline criterion is judged over up to
   // 6 runs: it holds when one run has none; the work bound is checked in every judged run.
@@ -348,17 +362,18 @@ TEST(SystemHostileInput, AFloodingCornerDoesNotDelayTheOthersCommands) {
   // meets the participants of the one before.
   constexpr int kAttempts = 6;
   const int domains[kAttempts] = {226, 227, 229, 230, 231, 232};
+  const bool run_at_realtime_priority = ::geteuid() == 0 && ::access("/usr/bin/chrt", X_OK) == 0;
   bool deadlines_held = false;
   int judged = 0;
   for (int attempt = 1; attempt <= kAttempts && !deadlines_held; ++attempt) {
     const std::string dir = scratch("flood_" + std::to_string(attempt));
     const std::string domain = std::to_string(domains[attempt - 1]);
-    auto l = start_launch(dir, domains[attempt - 1], "realtime", false);
+    auto l = start_launch(dir, domains[attempt - 1], "realtime", false, /*realtime_priority=*/true);
     const std::string run_id = l->run_id();
     ASSERT_EQ(run_id.size(), 16u) << l->out() << l->err();
     Intruder flood(dir, "intruder_flood", {"--as", "none", "--corner", "FL", "--measurements", "flood", "--rate-x", "20",
                                            "--domain", domain, "--duration-s", "60", "--run-id", run_id},
-                   true);
+                   /*niced=*/!run_at_realtime_priority);
     const ProcessRun r = finish_launch(*l);
     const bool flood_lasted = flood.running();
     const bbw::runtime::ExitStatus flood_status = flood.stop(20s);
@@ -409,7 +424,7 @@ TEST(SystemHostileInput, AFloodingCornerDoesNotDelayTheOthersCommands) {
   // without any flood. If it misses too, this machine cannot hold the 20 ms deadline right now
   // and the criterion cannot be judged (the bounded-work checks were asserted in every run).
   const std::string dir = scratch("flood_control");
-  const ProcessRun r = launch(dir, 226, "realtime", false);
+  const ProcessRun r = launch(dir, 226, "realtime", false, /*realtime_priority=*/true);
   ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
   double control_misses = 0.0;
   for (const char* c : {"FR", "RL", "RR"}) {
