@@ -60,6 +60,11 @@ class RemoveScratchOnPass : public ::testing::EmptyTestEventListener {
 };
 
 // A fresh, empty folder /tmp/bbw_<prefix>_<test>_<pid>, removed when the test passes.
+// Whether a run can be started under SCHED_FIFO (root and chrt): the prefix chrt_fifo() gives it.
+inline bool realtime_priority_available() { return ::geteuid() == 0 && ::access("/usr/bin/chrt", X_OK) == 0; }
+// "/usr/bin/chrt -f 10", to put before a command line (inherited by every process and thread it starts).
+inline std::vector<std::string> chrt_fifo() { return {"/usr/bin/chrt", "-f", "10"}; }
+
 inline std::string scratch(const std::string& prefix, const std::string& test) {
   namespace fs = std::filesystem;
   const fs::path p = fs::temp_directory_path() / ("bbw_" + prefix + "_" + test + "_" + std::to_string(::getpid()));

@@ -122,7 +122,7 @@ StandbyRun launch_standby(const std::string& scenario, const std::string& test, 
                           const std::vector<std::string>& extra = {}) {
   const std::string dir = scratch("failover", test);
   std::vector<std::string> argv;
-  if (mode == "realtime" && ::geteuid() == 0 && ::access("/usr/bin/chrt", X_OK) == 0) argv = {"/usr/bin/chrt", "-f", "10"};
+  if (mode == "realtime" && realtime_priority_available()) argv = chrt_fifo();
   for (const std::string& a : {bin("bbw_launch"), src("config/scenarios/faults/" + scenario), std::string("--out"),
                                dir + "/out", std::string("--mode"), mode, std::string("--domain"), std::to_string(domain),
                                std::string("--discovery-timeout"), std::string("20"), std::string("--no-report")}) {

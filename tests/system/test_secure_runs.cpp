@@ -55,7 +55,7 @@ ProcessRun run(const std::string& name, const std::vector<std::string>& argv, co
 std::vector<std::string> launch_argv(const std::string& dir, int domain, const std::string& mode, bool secure,
                                      bool realtime_priority = false) {
   std::vector<std::string> a;
-  if (realtime_priority && ::geteuid() == 0 && ::access("/usr/bin/chrt", X_OK) == 0) a = {"/usr/bin/chrt", "-f", "10"};
+  if (realtime_priority && bbw::system_test::realtime_priority_available()) a = bbw::system_test::chrt_fifo();
   for (const std::string& x : {bin("bbw_launch"), src("tests/system/data/short_rig.yaml"), std::string("--out"), dir + "/out",
                                std::string("--mode"), mode, std::string("--domain"), std::to_string(domain),
                                std::string("--discovery-timeout"), std::string("20"), std::string("--no-report")}) {
@@ -362,7 +362,7 @@ TEST(SystemHostileInput, AFloodingCornerDoesNotDelayTheOthersCommands) {
   // meets the participants of the one before.
   constexpr int kAttempts = 6;
   const int domains[kAttempts] = {226, 227, 229, 230, 231, 232};
-  const bool run_at_realtime_priority = ::geteuid() == 0 && ::access("/usr/bin/chrt", X_OK) == 0;
+  const bool run_at_realtime_priority = bbw::system_test::realtime_priority_available();
   bool deadlines_held = false;
   int judged = 0;
   for (int attempt = 1; attempt <= kAttempts && !deadlines_held; ++attempt) {
