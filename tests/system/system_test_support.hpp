@@ -13,6 +13,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -59,12 +60,16 @@ class RemoveScratchOnPass : public ::testing::EmptyTestEventListener {
   std::vector<std::string> dirs_;
 };
 
-// A fresh, empty folder /tmp/bbw_<prefix>_<test>_<pid>, removed when the test passes.
-// Whether a run can be started under SCHED_FIFO (root and chrt): the prefix chrt_fifo() gives it.
+// Whether a run can be started under SCHED_FIFO (root and chrt).
 inline bool realtime_priority_available() { return ::geteuid() == 0 && ::access("/usr/bin/chrt", X_OK) == 0; }
-// "/usr/bin/chrt -f 10", to put before a command line (inherited by every process and thread it starts).
-inline std::vector<std::string> chrt_fifo() { return {"/usr/bin/chrt", "-f", "10"}; }
+// argv under SCHED_FIFO 10 (`/usr/bin/chrt -f 10` before it, inherited by every process and thread
+// it starts) when realtime_priority_available(); else argv as it is.
+inline std::vector<std::string> at_realtime_priority(std::vector<std::string> argv) {
+  if (realtime_priority_available()) argv.insert(argv.begin(), {"/usr/bin/chrt", "-f", "10"});
+  return argv;
+}
 
+// A fresh, empty folder /tmp/bbw_<prefix>_<test>_<pid>, removed when the test passes.
 inline std::string scratch(const std::string& prefix, const std::string& test) {
   namespace fs = std::filesystem;
   const fs::path p = fs::temp_directory_path() / ("bbw_" + prefix + "_" + test + "_" + std::to_string(::getpid()));

@@ -121,14 +121,10 @@ struct StandbyRun {
 StandbyRun launch_standby(const std::string& scenario, const std::string& test, int domain, const std::string& mode,
                           const std::vector<std::string>& extra = {}) {
   const std::string dir = scratch("failover", test);
-  std::vector<std::string> argv;
-  if (mode == "realtime" && realtime_priority_available()) argv = chrt_fifo();
-  for (const std::string& a : {bin("bbw_launch"), src("config/scenarios/faults/" + scenario), std::string("--out"),
-                               dir + "/out", std::string("--mode"), mode, std::string("--domain"), std::to_string(domain),
-                               std::string("--discovery-timeout"), std::string("20"), std::string("--no-report")}) {
-    argv.push_back(a);
-  }
+  std::vector<std::string> argv{bin("bbw_launch"), src("config/scenarios/faults/" + scenario), "--out", dir + "/out", "--mode",
+                                 mode, "--domain", std::to_string(domain), "--discovery-timeout", "20", "--no-report"};
   argv.insert(argv.end(), extra.begin(), extra.end());
+  if (mode == "realtime") argv = at_realtime_priority(std::move(argv));
   StandbyRun r;
   for (int attempt = 1;; ++attempt) {
     r.launch = run("bbw_launch", argv, dir, 120s);

@@ -33,19 +33,15 @@ using LaunchRun = bbw::system_test::ProcessRun;
 
 // Runs the launcher; on the Fast DDS 2.9 discovery abort (and only on it: any other failure is
 // returned as it is) the run is repeated, at most twice, with a note in the test's output.
-// Realtime runs go under SCHED_FIFO 10 as root (chrt_fifo, inherited by every process the
+// Realtime runs go under SCHED_FIFO 10 as root (at_realtime_priority, inherited by every process the
 // launcher starts, a restarted corner too), as the failover tests' do: their criteria are wall
 // clock (a loss found within 50 ms, a restarted corner back before 2.5 s). At normal priority,
 // beside a sanitizer build, the restarted corner of SystemFaultsRealtime once came back only at
 // 2.76 s.
 LaunchRun launch(const std::string& scenario, const std::string& dir, int domain, const std::string& mode) {
-  std::vector<std::string> argv;
-  if (mode == "realtime" && realtime_priority_available()) argv = chrt_fifo();
-  for (const std::string& a : {bin("bbw_launch"), src(scenario), std::string("--out"), dir + "/out", std::string("--mode"), mode,
-                               std::string("--domain"), std::to_string(domain), std::string("--discovery-timeout"),
-                               std::string("20"), std::string("--no-report")}) {
-    argv.push_back(a);
-  }
+  std::vector<std::string> argv{bin("bbw_launch"), src(scenario), "--out", dir + "/out", "--mode", mode, "--domain",
+                                 std::to_string(domain), "--discovery-timeout", "20", "--no-report"};
+  if (mode == "realtime") argv = at_realtime_priority(std::move(argv));
   for (int attempt = 1;; ++attempt) {
     LaunchRun r = run("bbw_launch", argv, dir, 170s);
     const std::string abort_file = r.status.ok() ? "" : fastdds_pdp_abort(dir + "/out");

@@ -54,15 +54,11 @@ ProcessRun run(const std::string& name, const std::vector<std::string>& argv, co
 // the rest of the machine's load.
 std::vector<std::string> launch_argv(const std::string& dir, int domain, const std::string& mode, bool secure,
                                      bool realtime_priority = false) {
-  std::vector<std::string> a;
-  if (realtime_priority && bbw::system_test::realtime_priority_available()) a = bbw::system_test::chrt_fifo();
-  for (const std::string& x : {bin("bbw_launch"), src("tests/system/data/short_rig.yaml"), std::string("--out"), dir + "/out",
-                               std::string("--mode"), mode, std::string("--domain"), std::to_string(domain),
-                               std::string("--discovery-timeout"), std::string("20"), std::string("--no-report")}) {
-    a.push_back(x);
-  }
+  std::vector<std::string> a{bin("bbw_launch"), src("tests/system/data/short_rig.yaml"), "--out", dir + "/out",
+                             "--mode", mode, "--domain", std::to_string(domain), "--discovery-timeout", "20",
+                             "--no-report"};
   if (secure) a.insert(a.end(), {"--secure", "--keys", dir + "/keys"});
-  return a;
+  return realtime_priority ? bbw::system_test::at_realtime_priority(std::move(a)) : a;
 }
 
 ProcessRun launch(const std::string& dir, int domain, const std::string& mode, bool secure, bool realtime_priority = false) {
