@@ -237,9 +237,9 @@ TEST(ClosedLoop, ASeizedActuatorIsNamedNotReleasingAndItsHeldForceIsCounted) {
 
 // A drive that seizes in the middle of a held stop keeps its force where it is commanded, so no
 // rule that waits for motion sees it before the release. The corners' actuator test in holds
-// (back and forth by the hold's current and 1.5 A more, 3 ms each, every 0.15 s) gives the
-// monitor a rotor that does not answer: actuator_lost within the scorer's 0.5 s for a seized
-// drive, long before the release. The healthy corners answer, FR with a backlash in its gear
+// (back and forth by the hold's current and 1.5 A more, 3 ms each, every 15 ms) gives the
+// monitor a rotor that does not answer: actuator_lost within issue 14's 50 ms latency goal for
+// loss and stuck faults (two unanswered tests), long before the release. The healthy corners answer, FR with a backlash in its gear
 // too (a gear held against its flank moves back when the current changes sign).
 TEST(ClosedLoop, ADriveThatSeizesInAHoldIsFoundByTheActuatorTestBeforeTheRelease) {
   const auto fs = load("config/scenarios/faults/actuator_seized_in_hold.yaml");
@@ -252,7 +252,7 @@ TEST(ClosedLoop, ADriveThatSeizesInAHoldIsFoundByTheActuatorTestBeforeTheRelease
   const Diagnosis& fl = r.diagnoses[0 * 5 + static_cast<std::size_t>(Part::Actuator)];
   ASSERT_TRUE(fl.present);
   EXPECT_GT(fl.detected_s, seized_at_s);
-  EXPECT_LT(fl.detected_s - seized_at_s, 0.5);
+  EXPECT_LT(fl.detected_s - seized_at_s, 0.05);
   for (std::size_t c = 1; c < kCorners; ++c) {
     EXPECT_FALSE(r.diagnoses[c * 5 + static_cast<std::size_t>(Part::Actuator)].present) << "corner " << c;
   }

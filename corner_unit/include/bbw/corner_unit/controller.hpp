@@ -72,11 +72,11 @@ struct ControllerParams {
   // (faults::MonitorParams::test_pulse_*). 0 A: off.
   double hold_test_current_A = 1.5;
   double hold_test_pulse_s = 0.003;          // at most 7 sample periods (the monitor's history)
-  double hold_test_period_s = 0.15;
-  double hold_test_min_hold_s = 0.1;
+  double hold_test_period_s = 0.015;
+  double hold_test_min_hold_s = 0.015;
   double hold_test_min_force_kN = 1.0;
   double hold_test_max_speed_rev_per_s = 0.5;
-  double hold_test_max_error_kN = 0.5;
+  double hold_test_max_error_kN = 1.5;
 
   void validate() const;  // throws std::invalid_argument naming the field
 };

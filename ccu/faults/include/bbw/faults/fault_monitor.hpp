@@ -229,7 +229,7 @@ struct MonitorParams {
   double test_pulse_max_speed_rev_per_s = 0.2;
   double test_pulse_answer_ratio = 0.15;
   int test_pulse_unanswered = 2;
-  double test_pulse_within_s = 0.4;           // each unanswered pulse within this of the last judged one
+  double test_pulse_within_s = 0.04;          // each unanswered pulse within this of the last judged one
   // Tracking backstop: the force against a first-order model of the commanded response. A
   // shortfall below both is ActuatorTracking; an excess above both (a brake that does not
   // release) is ActuatorNotReleasing, with the same threshold and persistence.
