@@ -820,6 +820,50 @@ TEST(FaultMonitor, ALoadCellStepAtStandstillIsAnOffsetAtAnyForce) {
   EXPECT_TRUE(run([](int k) { return 30.0 + (k >= 150 ? 1.0 : 0.0); }, true).ok(Part::LoadCell));
 }
 
+// The corners' actuator test runs every 15 ms of a hold (issue 14, eleventh session): 3 ms back,
+// 3 ms forth, the rotor 0.1-1 mrev off and back by a little less. The step rule leaves the
+// pulse's samples out of its still window, so a bias that comes during a pulse, or right after
+// one, is still a step; a pulse alone is not, and neither is a current square that moves the
+// rotor further than a test does.
+TEST(FaultMonitor, ALoadCellStepDuringOrAfterAnActuatorTestIsStillAnOffset) {
+  MonitorParams p = noiseless();
+  p.test_pulse_current_A = 1.5;
+  p.test_pulse_s = 0.003;
+  SampleCheck ok;
+  const double hold_A = 30.0 * p.Nm_per_kN / p.torque_per_A_Nm;
+  const double a_A = hold_A + 1.5;
+  // A pulse over samples 140-145; the bias (if any) from sample `bias_from`; `net_rev` where the
+  // rotor stands after the pulse.
+  auto run = [&](int bias_from, double net_rev) {
+    FaultMonitor m(p, Target::FR);
+    for (int k = 1; k < 300; ++k) {
+      const double t = 0.001 * k;
+      double x = 4.2 + 2e-5 * ((k * 7) % 3), speed = 0.004 * ((k % 3) - 1), current = hold_A;
+      if (k >= 140 && k < 146) {
+        const int i = k - 140;
+        current = i < 3 ? hold_A - a_A : hold_A + a_A;
+        x += net_rev * (i + 1) / 6.0;
+        speed = 0.1 * (i < 3 ? -1.0 : 1.0);
+      } else if (k >= 146) {
+        x += net_rev;
+      }
+      const double lc = 30.0 + 0.03 * ((k % 5) - 2) + (bias_from > 0 && k >= bias_from ? 1.0 : 0.0);
+      auto r = at(k, t, x, lc);
+      r.speed_rev_per_s = speed;
+      r.motor_current_A = current;
+      m.update(r, ok, nullptr, r.force_kN, r.time_s);
+    }
+    return m.diagnosis(Part::LoadCell);
+  };
+  for (int from : {143, 145, 146, 150}) {
+    const Diagnosis d = run(from, -6e-4);
+    EXPECT_EQ(d.finding, Finding::LoadCellOffset) << "bias from sample " << from;
+    EXPECT_LT(d.detected_s, 0.001 * from + 0.015) << "bias from sample " << from;
+  }
+  EXPECT_FALSE(run(0, -6e-4).present);  // the pulse alone
+  EXPECT_FALSE(run(143, -5e-3).present);  // a square that moved the rotor 5 mrev: not a still window
+}
+
 // Before any fit (issue 14): once the position has swept twice the largest key-friction
 // threshold, the end-of-line friction model's state is known, its friction is subtracted and the
 // band narrows from the whole half-width to its model share; and while the actuator holds, the

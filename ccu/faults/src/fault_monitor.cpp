@@ -206,6 +206,7 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   const bool load_cell_load = check.load_cell_present && arbiter_.ok(Part::LoadCell);
   const double load_kN = load_cell_load ? r.force_kN : force_estimate_kN;
   torque_.update(c, load_kN, load_cell_load, p_, arbiter_);
+  if (torque_.test_pulse_samples() > 0) step_.on_test_pulse(torque_.test_pulse_samples(), r.time_s, p_);
   // Without commutation the force no longer follows the command because of the resolver, not of
   // a second fault in the actuator.
   if (commutation_lost()) {

@@ -14,6 +14,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
                             DiagnosisArbiter& a) {
   const CornerReading& r = c.r;
   const double t = r.time_s;
+  pulse_samples_ = 0;
   const double accel = c.have_prev && c.dt_s > 0.0 ? (r.speed_rev_per_s - c.prev.speed_rev_per_s) / c.dt_s : 0.0;
   // A frozen resolver repeats its last (noisy, so nonzero) speed exactly.
   const bool repeated = c.have_prev && r.speed_rev_per_s != 0.0 && r.speed_rev_per_s == c.prev.speed_rev_per_s;
@@ -170,6 +171,7 @@ void TorqueDetector::update_response(const SampleContext& c, const MonitorParams
   const bool square =
       fell && crosses && plus_A - minus_A >= 1.3 * amp_A && plus_min_A - minus_max_A >= 0.8 * amp_A;
   const double v0 = response_speed_[at(2 * m + 1)];
+  if (square) pulse_samples_ = 2 * m;
   if (!square || std::abs(v0) > p.test_pulse_max_speed_rev_per_s) return;
   constexpr double kTwoPi = 6.283185307179586;
   // A free rotor's answer to the measured swing: each half's current is half the swing off the

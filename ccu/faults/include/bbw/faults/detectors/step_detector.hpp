@@ -20,14 +20,24 @@ class StepDetector {
   void update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() { reset(); }
   bool pending() const { return pending_; }
+  // The corner's actuator test in holds ran over the `samples` samples before this one (the torque
+  // rule recognises it at the first sample after it). They are left out of the still window: the pulse moves the rotor
+  // 0.1-0.7 mrev and back by a little less (up to 1 mrev net), and the clamp force by a few N to tens of N, so the
+  // still samples on either side of it still show the level a load-cell step would leave. Without
+  // this a test every 15 ms left a hold almost no still window (issue 14, eleventh session).
+  // A load-cell step during the pulse is judged here against the still samples before it.
+  void on_test_pulse(int samples, double time_s, const MonitorParams& p);
 
  private:
   void reset() {
     count_ = 0;
     pending_ = false;
   }
+  bool still_level(const MonitorParams& p, double x_now, int skip, double across_pulse, double& level) const;
+  void begin_step(double level_kN, double step_kN, double time_s);
   std::array<double, kMaxWindow> x_{};
   std::array<double, kMaxWindow> lc_{};
+  std::array<bool, kMaxWindow> pulse_{};  // the sample belonged to a test pulse
   int head_ = 0;   // next slot
   int count_ = 0;  // samples in the window
   bool pending_ = false;

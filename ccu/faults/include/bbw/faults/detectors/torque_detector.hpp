@@ -37,6 +37,9 @@ class TorqueDetector {
   double fraction() const { return fraction_; }
   // Filtered made - needed torque at the last checked sample (the unexplained-torque rule's).
   double excess_Nm() const { return excess_Nm_; }
+  // The samples of a test pulse recognised at this sample (its two halves, which ended with the
+  // sample before; answered or not), else 0: the step rule leaves them out of its still window.
+  int test_pulse_samples() const { return pulse_samples_; }
 
  private:
   bool torque_suspect_ = false;
@@ -69,6 +72,7 @@ class TorqueDetector {
   double response_dt_s_ = 0.0;  // their spacing
   int response_head_ = 0;
   int unanswered_ = 0;
+  int pulse_samples_ = 0;  // a pulse recognised at this sample: its samples, else 0
   double unanswered_since_s_ = 0.0;
   double last_pulse_s_ = 0.0;  // when the last pulse was judged
   // The seized-in-a-hold rule: where and when the drive stopped, the least made torque since.
