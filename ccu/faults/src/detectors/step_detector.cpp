@@ -25,7 +25,7 @@ void StepDetector::update(const SampleContext& c, const MonitorParams& p, Diagno
     reset();  // returned: noise, not a bias
   }
   double level = 0.0;
-  if (still_level(p, r.position_rev, 0, 2.0, level)) {
+  if (still_level(p, r.position_rev, 0, kAcrossPulseSpans, level)) {
     const double d = r.force_kN - level;
     if (std::abs(d) >= p.step_kN) {
       begin_step(level, d, r.time_s);
@@ -41,9 +41,9 @@ void StepDetector::update(const SampleContext& c, const MonitorParams& p, Diagno
 
 // The still window: the last step_still_samples samples that were not a test pulse's (the newest
 // `skip` left out: the sample judged, when it is already held), with the position `x_now` of the
-// sample judged. A pulse splits it into segments, each of which must be
-// still; across a pulse the rotor may stand `across_pulse` still spans off (the pulse's own travel,
-// 0.1-1 mrev; the clamp force that moves is tens of N).
+// sample judged. A pulse splits it into segments, each of which must be still; across a pulse the
+// rotor may stand `across_pulse` still spans off (the pulse's own travel, 0.1-1 mrev; the clamp
+// force that moves is tens of N).
 bool StepDetector::still_level(const MonitorParams& p, double x_now, int skip, double across_pulse, double& level) const {
   const int n = p.step_still_samples;
   if (count_ - skip < n) return false;
@@ -99,7 +99,7 @@ void StepDetector::on_test_pulse(int samples, double time_s, const MonitorParams
   // that came during the pulse, which its samples hid while it ran.
   const auto now = static_cast<std::size_t>((head_ - 1 + kMaxWindow) % kMaxWindow);
   double level = 0.0;
-  if (!still_level(p, x_[now], 1, 3.0, level)) return;
+  if (!still_level(p, x_[now], 1, kDuringPulseSpans, level)) return;
   const double d = lc_[now] - level;
   if (std::abs(d) < p.step_kN) return;
   // ... and a step, not a slide: at least half of it between two samples (a bias comes at once; a
@@ -110,7 +110,7 @@ void StepDetector::on_test_pulse(int samples, double time_s, const MonitorParams
     const auto before = static_cast<std::size_t>((head_ - k - 1 + kMaxWindow) % kMaxWindow);
     jump = std::max(jump, std::abs(lc_[i] - lc_[before]));
   }
-  if (jump >= 0.5 * std::abs(d)) begin_step(level, d, time_s);
+  if (jump >= kStepJumpShare * std::abs(d)) begin_step(level, d, time_s);
 }
 
 }  // namespace bbw::faults

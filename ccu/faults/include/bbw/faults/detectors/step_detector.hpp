@@ -20,12 +20,18 @@ class StepDetector {
   void update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() { reset(); }
   bool pending() const { return pending_; }
-  // The corner's actuator test in holds ran over the `samples` samples before this one (the torque
-  // rule recognises it at the first sample after it). They are left out of the still window: the pulse moves the rotor
-  // 0.1-0.7 mrev and back by a little less (up to 1 mrev net), and the clamp force by a few N to tens of N, so the
-  // still samples on either side of it still show the level a load-cell step would leave. Without
-  // this a test every 15 ms left a hold almost no still window (issue 14, eleventh session).
-  // A load-cell step during the pulse is judged here against the still samples before it.
+  // The corner's actuator test in holds ran over the `samples` samples before this one (the
+  // torque rule recognises it at the first sample after it). They leave the still window: the
+  // pulse moves the rotor 0.1-0.7 mrev and back by a little less (up to 1 mrev net) and the clamp
+  // force by a few N to tens of N, so the still samples on either side still show the level a
+  // load-cell step leaves (kAcrossPulseSpans still spans apart at most). A step that came during
+  // the pulse is judged here, at the sample after it, against the still samples before it
+  // (kDuringPulseSpans apart, the loop may already be moving the rotor; at least kStepJumpShare
+  // of it between two samples). Without this a test every 15 ms left a hold almost no still
+  // window (issue 14, eleventh session).
+  static constexpr double kAcrossPulseSpans = 2.0;
+  static constexpr double kDuringPulseSpans = 3.0;
+  static constexpr double kStepJumpShare = 0.5;
   void on_test_pulse(int samples, double time_s, const MonitorParams& p);
 
  private:
