@@ -139,6 +139,31 @@ void CcuApp::drain_health() {
   }
 }
 
+// A lockstep CCU that has left the run stays matched until the corners are done (their block
+// writers gone) or the peer timeout, taking and dropping what they send. Its readers leaving while
+// the corners still ran made a corner's writer remove a matched reader while that writer's
+// flow-controller thread was sending to it, which deadlocks Fast DDS 2.9 (its matched_reader_remove
+// against FlowControllerImpl::run; fixed upstream after 2.9, eProsima/Fast-DDS#3468): seen once in
+// the system set beside a sanitizer build, SystemFailover.HungPrimaryLockstepLeavesTheRun, the
+// front-right corner hung in DataWriter::write and the run stalled to its bound.
+void CcuApp::linger_until_corners_done() {
+  transport::EndpointId writer = 0;
+  events_.wait_until(Clock::now() + options_.peer_timeout, [&] {
+    bool matched = false;
+    for (auto& b : blocks_) {
+      while (b->take(block_, writer)) {
+      }
+      matched = matched || b->peers() > 0;
+    }
+    msg::CornerHealth& h = health_in_;
+    for (auto& r : health_) {
+      while (r->take(h)) {
+      }
+    }
+    return !matched;
+  });
+}
+
 // A vehicle run: the vehicle's and the pedal's period reports into the brake functions and the barrier.
 void CcuApp::drain_vehicle() {
   if (!brake_) return;
@@ -568,6 +593,7 @@ int CcuApp::run(std::string& error) {
   }
   if (retired) {
     if (log_ != nullptr) log_->flush();
+    linger_until_corners_done();
     return rc;
   }
   send_commands(periods_, true);

@@ -79,6 +79,7 @@ class CcuApp {
   void drain_blocks_in_order(double arrival_s, std::uint64_t step);
   void drain_qos_events(double now_s, bool lockstep);
   void drain_health();
+  void linger_until_corners_done();
   bool wait_for_rejoin(std::size_t channel, std::uint32_t incarnation, std::string& error);
   [[noreturn]] void freeze_for_kill(double at_s);
   // The scheduled hang: freezes (SIGSTOP) like a kill; returns when the launcher continues it.
