@@ -142,10 +142,12 @@ void CcuApp::drain_health() {
 // A lockstep CCU that has left the run stays matched until the corners are done (their block
 // writers gone) or the peer timeout, taking and dropping what they send. Its readers leaving while
 // the corners still ran made a corner's writer remove a matched reader while that writer's
-// flow-controller thread was sending to it, which deadlocks Fast DDS 2.9 (its matched_reader_remove
-// against FlowControllerImpl::run; fixed upstream after 2.9, eProsima/Fast-DDS#3468): seen once in
-// the system set beside a sanitizer build, SystemFailover.HungPrimaryLockstepLeavesTheRun, the
-// front-right corner hung in DataWriter::write and the run stalled to its bound.
+// flow-controller thread was sending to it, which can deadlock Fast DDS 2.9: the lock-order
+// inversion between StatefulWriter::matched_reader_remove and the flow controller's thread of
+// eProsima/Fast-DDS#3468 and #5432 (the latter merged in 2024 for 2.10 and later). Seen once in the
+// system set beside a sanitizer build, SystemFailover.HungPrimaryLockstepLeavesTheRun: the
+// front-right corner hung in DataWriter::write (gdb of the live process) and the run stalled to
+// its bound.
 void CcuApp::linger_until_corners_done() {
   transport::EndpointId writer = 0;
   events_.wait_until(Clock::now() + options_.peer_timeout, [&] {
