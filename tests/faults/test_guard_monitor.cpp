@@ -1127,6 +1127,83 @@ TEST(FaultMonitor, ALoadCellThatFollowsTheModelLateIsNotNoise) {
 // residual crept to 1.2 kN, found 8.5 s late as `actuator_torque_loss`). The hold's settled
 // level does not follow: a 0.6 kN/s drift from 4 s is found within its scoring window
 // (1.0 kN / 0.6 kN/s + 0.5 s), a healthy hold raises nothing.
+// A calibrated corner whose residual carries a model error (0.3 kN with the position) learns
+// its threshold from it; a 1 kN/s load-cell drift while the brake modulates (never a hold) grows
+// under that threshold. Learnt in full, the drift's own square widened the threshold as fast as
+// the drift grew (tune_bias run 38); bounded at stats_clip sigmas, it is named in its window.
+TEST(FaultMonitor, ASlowDriftCannotWidenTheLearntThresholdAsFastAsItGrows) {
+  auto run = [](double clip, double drift_kN_per_s) {
+    MonitorParams p = eol_params(1.5, false);
+    p.hold_calibrated = false;  // the residual rule alone
+    p.residual_stats_clip = clip;
+    EolCaliper caliper{p};
+    auto& [eol, keys, T] = caliper;
+    FaultMonitor m(p, Target::RL);
+    SampleGuard g{MonitorParams{}.guard};
+    double x = 0.0;
+    for (int n = 1; n < 16000; ++n) {
+      const double t = 0.001 * n;
+      // Apply to 3.5 rev, then modulate +/- 0.4 rev at 0.6 Hz.
+      const double speed = t < 1.0 ? 3.5 : 0.4 * 2.0 * M_PI * 0.6 * std::cos(2.0 * M_PI * 0.6 * (t - 1.0));
+      x += 0.001 * speed;
+      const double friction_kN = keys.step(x);
+      const double model_error_kN = 0.3 * std::sin(2.0 * M_PI * x / 0.37);
+      const double drift_kN = t > 12.0 ? drift_kN_per_s * (t - 12.0) : 0.0;
+      const double lc = eol.force_kN(x, T, 0.0) + friction_kN + model_error_kN + drift_kN + 0.03 * ((n % 5) - 2);
+      const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
+      const auto e = fitted(t > 0.5, lc, friction_kN, eol.force_kN(x, T, 0.0));
+      m.update(r, g.check(r), &e, e.force_kN, t);
+    }
+    return m.diagnosis(Part::LoadCell);
+  };
+  const double window_end_s = 12.0 + 1.0 / 1.0 + 0.5;
+  const auto unbounded = run(0.0, 1.0);
+  EXPECT_TRUE(!unbounded.present || unbounded.detected_s > window_end_s) << unbounded.detected_s;
+  const auto healthy = run(1.5, 0.0);
+  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
+  const auto d = run(1.5, 1.0);
+  EXPECT_EQ(d.finding, Finding::LoadCellOffset) << to_string(d.finding);
+  EXPECT_GT(d.detected_s, 12.0);
+  EXPECT_LT(d.detected_s, window_end_s);
+}
+
+// A drift that starts in a hold before the first fit: the fit, mid-hold, changes how the
+// residual is computed. Restarting the hold there threw away the change the drift had made
+// (tune_bias run 10: 0.5 kN in a held hard stop); rebased, the hold carries it across.
+TEST(FaultMonitor, AHoldCarriesADriftsChangeAcrossTheFirstFit) {
+  auto run = [](bool rebase, double drift_kN_per_s) {
+    MonitorParams p = eol_params(1.5, false);
+    p.hold_rebase = rebase;
+    EolCaliper caliper{p};
+    auto& [eol, keys, T] = caliper;
+    FaultMonitor m(p, Target::RL);
+    SampleGuard g{MonitorParams{}.guard};
+    double x = 0.0;
+    for (int n = 1; n < 8000; ++n) {
+      const double t = 0.001 * n;
+      const double speed = t < 1.0 ? 4.6 : 0.0;  // apply to about 20 kN, then hold
+      x += 0.001 * speed;
+      const double friction_kN = keys.step(x);
+      const double drift_kN = t > 4.0 ? drift_kN_per_s * (t - 4.0) : 0.0;
+      const double lc = eol.force_kN(x, T, 0.0) + friction_kN + drift_kN + 0.03 * ((n % 5) - 2);
+      const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
+      // The first fit comes at 5 s, in the hold; before it, the load cell as it is.
+      const auto e = t > 5.0 ? fitted(true, lc, friction_kN, eol.force_kN(x, T, 0.0)) : uncalibrated(lc);
+      m.update(r, g.check(r), &e, e.force_kN, t);
+    }
+    return m.diagnosis(Part::LoadCell);
+  };
+  const double window_end_s = 4.0 + 1.0 / 0.6 + 0.5;
+  const auto restarted = run(false, -0.6);
+  EXPECT_TRUE(!restarted.present || restarted.detected_s > window_end_s) << restarted.detected_s;
+  const auto healthy = run(true, 0.0);
+  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
+  const auto d = run(true, -0.6);
+  EXPECT_EQ(d.finding, Finding::LoadCellOffset) << to_string(d.finding);
+  EXPECT_GT(d.detected_s, 5.0);
+  EXPECT_LT(d.detected_s, window_end_s);
+}
+
 TEST(FaultMonitor, CalibratedAHoldKeepsItsLevelWhileTheLearntStatisticsFollowADrift) {
   auto run = [](bool hold_calibrated, double drift_kN_per_s) {
     MonitorParams p = eol_params(1.5, false);

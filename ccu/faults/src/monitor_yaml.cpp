@@ -29,6 +29,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.residual_change_threshold_kN = res.number("change_threshold_kN", pos);
   p.residual_sigma_factor = res.number("sigma_factor", pos);
   p.residual_stats_s = res.number("stats_s", pos);
+  p.residual_stats_clip = res.number("stats_clip", config::Range::non_negative());
   p.residual_speed_kN_per_rev_per_s = res.number("speed_kN_per_rev_per_s", config::Range::non_negative());
   p.residual_speed_free_rev_per_s = res.number("speed_free_rev_per_s", config::Range::non_negative());
   {
@@ -48,6 +49,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.hold_span_rev = h.number("span_rev", pos);
     p.hold_settle_samples = static_cast<int>(h.integer("settle_samples", 1, 100000));
     p.hold_calibrated = h.boolean("calibrated");
+    p.hold_rebase = h.boolean("rebase");
     h.finish();
   }
   p.curve_min_rev = res.number("curve_min_rev");

@@ -190,8 +190,21 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // reference averaged across the change is neither level (extreme population run 75: 19 samples
   // before the friction model came in, one after, a 1.1 kN "change" on a healthy caliper).
   const bool settling_or_set = hold_ref_ || hold_slow_ > 0;
-  if (!slow || (settling_or_set && (hold_eol_mode_ != eol_here || hold_known_ != friction_known_)) ||
-      (hold_ref_ && std::abs(x_hold - hold_x0_rev_) > p.hold_span_rev)) {
+  bool redefined = settling_or_set && (hold_eol_mode_ != eol_here || hold_known_ != friction_known_ || hold_refit_);
+  // With hold.rebase, a settled hold carries its change across a new definition (or a new fit):
+  // the reference moves by the residual's jump between this sample and the last, which within a
+  // hold is the definition's, not the load's (a drift's 2 N per ms). A first fit in a held hard
+  // stop no longer throws away the 0.5 kN a drift had already moved (tune_bias run 10).
+  if (redefined && p.hold_rebase && hold_ref_ && slow && std::isfinite(hold_last_kN_)) {
+    hold_r0_kN_ += residual_kN_ - hold_last_kN_;
+    hold_x0_rev_ += x_hold - hold_last_x_rev_;
+    hold_f0_kN_ += hold_curve_kN - hold_last_curve_kN_;
+    hold_eol_mode_ = eol_here;
+    hold_known_ = friction_known_;
+    redefined = false;
+  }
+  hold_refit_ = false;
+  if (!slow || redefined || (hold_ref_ && std::abs(x_hold - hold_x0_rev_) > p.hold_span_rev)) {
     hold_ref_ = false;
     hold_slow_ = 0;
     hold_sum_kN_ = 0.0;
@@ -218,13 +231,26 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
                             (friction_known_ ? p.eol_friction_model_share : 1.0) * p.eol_friction_half_width_kN;
     hold_over = std::abs(hold_change_kN_) > hold_thr;
   }
+  hold_last_kN_ = slow ? residual_kN_ : std::numeric_limits<double>::quiet_NaN();
+  hold_last_x_rev_ = x_hold;
+  hold_last_curve_kN_ = hold_curve_kN;
   const bool over = p.residual_findings &&
                     (std::abs(residual_kN_) > thr || (change_rule && std::abs(change_kN_) > change_thr) || hold_over);
   if (!over && !eol_here && e.calibrated && std::isfinite(ms_residual_kN2_) && std::isfinite(change_kN_)) {
     // Healthy: the corner's own residual statistics follow (never while suspected).
     const double w = -std::expm1(-std::max(0.0, t - stats_time_s_) / p.residual_stats_s);
-    ms_residual_kN2_ += (residual_kN_ * residual_kN_ - ms_residual_kN2_) * w;
-    ms_change_kN2_ += (change_kN_ * change_kN_ - ms_change_kN2_) * w;
+    // Each sample's share is bounded at stats_clip sigmas of what was learnt so far: a slow
+    // load-cell drift stays under the threshold while it grows, and learning its square in full
+    // widened the threshold as fast as the residual grew (tune_bias run 38: a -1.27 kN/s drift in
+    // a hold, threshold 1.39 -> 2.36 kN while the residual went -0.6 -> -1.8 kN).
+    double r2 = residual_kN_ * residual_kN_, c2 = change_kN_ * change_kN_;
+    if (p.residual_stats_clip > 0.0) {
+      const double k2 = p.residual_stats_clip * p.residual_stats_clip;
+      r2 = std::min(r2, k2 * ms_residual_kN2_);
+      c2 = std::min(c2, k2 * ms_change_kN2_);
+    }
+    ms_residual_kN2_ += (r2 - ms_residual_kN2_) * w;
+    ms_change_kN2_ += (c2 - ms_change_kN2_) * w;
   }
   stats_time_s_ = t;
   if (!over) {

@@ -55,6 +55,9 @@ struct MonitorParams {
   // over residual_stats_s, updated only while nothing is suspected. docs/faults.md, "Thresholds".
   double residual_sigma_factor = 4.0;
   double residual_stats_s = 5.0;
+  // A sample adds at most residual_stats_clip^2 times the learnt mean square (0: no bound), so a
+  // slow fault under the threshold cannot widen it as fast as it grows.
+  double residual_stats_clip = 1.5;
   double residual_speed_kN_per_rev_per_s = 0.3;  // added to both, times |speed| beyond:
   double residual_speed_free_rev_per_s = 3.0;
   // The end-of-line curve: the caliper's own clamp curve with its temperature coefficients, as
@@ -91,6 +94,9 @@ struct MonitorParams {
   // The hold rule on calibrated corners too (with an end-of-line curve): the learnt residual
   // statistics follow a slow drift the loop absorbs by creeping; the hold's level does not.
   bool hold_calibrated = true;
+  // A settled hold carries its change across a change of the residual's definition or a new
+  // fit (its reference moves by the residual's jump between two samples) instead of restarting.
+  bool hold_rebase = true;
   double eol_band_kN = 0.5;
   double eol_relative = 0.03;
   double eol_speed_kN_per_rev_per_s = 0.3;

@@ -49,9 +49,7 @@ class ResidualDetector {
   // (the thresholds use these until the next fit, so a slow fault cannot widen them).
   void set_fit_rms(double fit_rms_kN) {
     fit_rms_kN_ = fit_rms_kN;
-    hold_ref_ = false;  // a new fit moves the calibrated residual by itself
-    hold_slow_ = 0;
-    hold_sum_kN_ = 0.0;
+    hold_refit_ = true;  // a new fit moves the calibrated residual by itself: the hold restarts (or rebases)
     if (std::isfinite(ms_residual_kN2_)) {
       sigma_residual_kN_ = std::sqrt(ms_residual_kN2_);
       sigma_change_kN_ = std::sqrt(ms_change_kN2_);
@@ -116,6 +114,11 @@ class ResidualDetector {
   double hold_x0_rev_ = 0.0;
   double hold_f0_kN_ = 0.0;
   double hold_change_kN_ = std::numeric_limits<double>::quiet_NaN();
+  bool hold_refit_ = false;  // a fit was accepted since the last sample
+  // The last sample's residual (NaN when it was not slow), key position and curve, for a rebase.
+  double hold_last_kN_ = std::numeric_limits<double>::quiet_NaN();
+  double hold_last_x_rev_ = 0.0;
+  double hold_last_curve_kN_ = 0.0;
 };
 
 }  // namespace bbw::faults
