@@ -45,15 +45,11 @@ class ResidualDetector {
     curve_min_rev_ = min_rev;
     curve_max_rev_ = max_rev;
   }
-  // At an accepted fit: its residual RMS, and a snapshot of the healthy residual's statistics
-  // (the thresholds use these until the next fit, so a slow fault cannot widen them).
+  // At an accepted fit: its residual RMS (a floor of the calibrated thresholds' sigma). What keeps
+  // a slow fault from widening the learnt statistics is residual_stats_clip.
   void set_fit_rms(double fit_rms_kN) {
     fit_rms_kN_ = fit_rms_kN;
     hold_refit_ = true;  // a new fit moves the calibrated residual by itself: the hold restarts (or rebases)
-    if (std::isfinite(ms_residual_kN2_)) {
-      sigma_residual_kN_ = std::sqrt(ms_residual_kN2_);
-      sigma_change_kN_ = std::sqrt(ms_change_kN2_);
-    }
   }
   // Whether the calibrated residual may use the last accepted fit (FaultMonitor::set_fit_friction_amplitude).
   void set_fit_credible(bool credible) { fit_credible_ = credible; }
@@ -92,8 +88,6 @@ class ResidualDetector {
   double ms_residual_kN2_ = std::numeric_limits<double>::quiet_NaN();
   double ms_change_kN2_ = std::numeric_limits<double>::quiet_NaN();
   double stats_time_s_ = 0.0;
-  double sigma_residual_kN_ = 0.0;  // snapshots at the last accepted fit
-  double sigma_change_kN_ = 0.0;
   std::optional<plant::ClampCurve> eol_;
   // The caliper's end-of-line key-friction model (Maxwell-slip elements as its production line
   // identified them), driven by the measured position.
