@@ -241,6 +241,26 @@ TEST(ClosedLoop, ASeizedActuatorIsNamedNotReleasingAndItsHeldForceIsCounted) {
 // monitor a rotor that does not answer: actuator_lost within issue 14's 50 ms latency goal for
 // loss and stuck faults (two unanswered tests), long before the release. The healthy corners answer, FR with a backlash in its gear
 // too (a gear held against its flank moves back when the current changes sign).
+TEST(ClosedLoop, ALoadCellBiasDuringASlowFirstApplyIsFoundWhileTheRotorMoves) {
+  const auto fs = load("config/scenarios/faults/load_cell_bias_while_applying.yaml");
+  const double at_s = fs.faults.faults.at(0).at_s;
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  const auto& o = r.outcomes[0];
+  EXPECT_TRUE(o.detected && o.correct);
+  EXPECT_EQ(o.diagnosis, Finding::LoadCellOffset);
+  EXPECT_LT(o.latency_ms, 20.0);
+  EXPECT_EQ(r.faults_raised(), 1u);  // healthy corners with a backlash, viscous friction, a delay: nothing
+  auto opts = default_options();
+  opts.monitor.step_moving = false;
+  const auto base = run_closed_loop(fs, opts);
+  ASSERT_EQ(base.outcomes.size(), 1u);
+  // Without the moving step rule: the end-of-line band, or the still rule once the apply stops.
+  EXPECT_TRUE(!base.outcomes[0].detected || base.outcomes[0].latency_ms > 100.0) << base.outcomes[0].latency_ms;
+  std::printf("bias while applying at %.1f s: found %.0f ms later with the moving step rule, %s without it\n", at_s,
+              o.latency_ms, base.outcomes[0].detected ? (std::to_string(base.outcomes[0].latency_ms) + " ms").c_str() : "not");
+}
+
 TEST(ClosedLoop, ADriveThatSeizesInAHoldIsFoundByTheActuatorTestBeforeTheRelease) {
   const auto fs = load("config/scenarios/faults/actuator_seized_in_hold.yaml");
   ASSERT_GT(fs.scenario.controller.hold_test_current_A, 0.0);

@@ -825,6 +825,65 @@ TEST(FaultMonitor, ALoadCellStepAtStandstillIsAnOffsetAtAnyForce) {
 // pulse's samples out of its still window, so a bias that comes during a pulse, or right after
 // one, is still a step; a pulse alone is not, and neither is a current square that moves the
 // rotor further than a test does.
+// A load-cell bias during an apply, before the first fit: the still step rule waits for the rotor
+// to stop and the end-of-line band for its 1-3 kN; the moving step rule names it within a few
+// samples (tune_bias run 153). Healthy applies, reversals and releases on a caliper with stiff
+// keys, and a noise burst while moving, are no offset; nor is a resolver jump while moving.
+TEST(FaultMonitor, ALoadCellStepWhileTheActuatorMovesIsAnOffset) {
+  struct Out {
+    Diagnosis load_cell, resolver;
+  };
+  // Apply at 2 rev/s from 0.5 to 4 rev, back to 2.5 rev, forward again to 4.5 rev; the fault
+  // `kind` at 1.2 s (moving forward at about 2.9 rev): 1 bias, 2 noise burst, 3 resolver jump.
+  auto run = [](bool moving, int kind, double magnitude, bool stiff) {
+    MonitorParams p = eol_params(1.5, stiff);
+    p.step_moving = moving;
+    EolCaliper caliper{p};
+    auto& [eol, keys, T] = caliper;
+    FaultMonitor m(p, Target::FL);
+    SampleGuard g{MonitorParams{}.guard};
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    double x = 0.5;
+    keys.reset(x);
+    for (int n = 1; n < 5000; ++n) {
+      const double t = 0.001 * n;
+      const double speed = t < 1.75 ? 2.0 : t < 2.5 ? -2.0 : t < 3.5 ? 2.0 : 0.0;
+      x += 0.001 * speed;
+      const double friction_kN = keys.step(x);
+      double lc = eol.force_kN(x, T, 0.0) + friction_kN + 0.03 * noise(rng);
+      double x_read = x;
+      if (t >= 1.2) {
+        if (kind == 1) lc += magnitude;
+        if (kind == 2 && t < 1.7) lc += magnitude * noise(rng);
+        if (kind == 3) x_read += magnitude;
+      }
+      const auto r = live_reading(n, t, x_read, speed + 0.004 * ((n % 3) - 1), lc, p);
+      const auto e = uncalibrated(lc);
+      m.update(r, g.check(r), &e, e.force_kN, t);
+    }
+    return Out{m.diagnosis(Part::LoadCell), m.diagnosis(Part::Resolver)};
+  };
+  for (bool stiff : {false, true}) {
+    SCOPED_TRACE(stiff ? "stiff keys" : "soft keys");
+    const auto healthy = run(true, 0, 0.0, stiff);
+    EXPECT_FALSE(healthy.load_cell.present) << to_string(healthy.load_cell.finding) << " at " << healthy.load_cell.detected_s;
+    for (double bias_kN : {-1.0, 1.0}) {
+      const auto found = run(true, 1, bias_kN, stiff);
+      EXPECT_EQ(found.load_cell.finding, Finding::LoadCellOffset) << bias_kN;
+      EXPECT_GE(found.load_cell.detected_s, 1.2);
+      EXPECT_LT(found.load_cell.detected_s, 1.21) << bias_kN;
+      const auto without = run(false, 1, bias_kN, stiff);
+      EXPECT_TRUE(!without.load_cell.present || without.load_cell.detected_s > 1.3) << without.load_cell.detected_s;
+    }
+    const auto burst = run(true, 2, 0.4, stiff);
+    EXPECT_NE(burst.load_cell.finding, Finding::LoadCellOffset) << "at " << burst.load_cell.detected_s;
+    const auto jump = run(true, 3, 0.05, stiff);
+    EXPECT_NE(jump.load_cell.finding, Finding::LoadCellOffset) << "at " << jump.load_cell.detected_s;
+    EXPECT_EQ(jump.resolver.finding, Finding::ResolverOffset);
+  }
+}
+
 TEST(FaultMonitor, ALoadCellStepDuringOrAfterAnActuatorTestIsStillAnOffset) {
   MonitorParams p = noiseless();
   p.test_pulse_current_A = 1.5;

@@ -66,6 +66,12 @@ void MonitorParams::validate() const {
   require(step_keep_fraction > 0.0 && step_keep_fraction <= 1.0, "step_keep_fraction", step_keep_fraction,
           "must be in (0, 1]");
   require(step_confirm_samples >= 1, "step_confirm_samples", step_confirm_samples, "must be >= 1");
+  require(step_moving_window_samples >= 3 && step_moving_window_samples <= MovingStepDetector::kMaxWindow,
+          "step_moving_window_samples", step_moving_window_samples, "must be in [3, 64]");
+  positive("step_moving_quiet_fraction", step_moving_quiet_fraction);
+  positive("step_moving_unexplained_rev", step_moving_unexplained_rev);
+  require(std::isfinite(step_moving_speed_kN_per_rev_per_s) && step_moving_speed_kN_per_rev_per_s >= 0.0,
+          "step_moving_speed_kN_per_rev_per_s", step_moving_speed_kN_per_rev_per_s, "must be >= 0");
   require(stuck_frozen_samples >= 2, "stuck_frozen_samples", stuck_frozen_samples, "must be >= 2");
   require(std::isfinite(stuck_frozen_run_factor) && stuck_frozen_run_factor >= 0.0, "stuck_frozen_run_factor",
           stuck_frozen_run_factor, "must be finite and >= 0");
@@ -163,7 +169,7 @@ Part part_of(Finding f) {
 }
 
 FaultMonitor::FaultMonitor(const MonitorParams& params, Target corner)
-    : p_((params.validate(), params)), corner_(corner), residual_(params), torque_(params) {
+    : p_((params.validate(), params)), corner_(corner), residual_(params), torque_(params), moving_step_(params) {
   if (!corner_slot(corner)) throw std::invalid_argument("FaultMonitor: monitors a corner, not the CCU");
 }
 
@@ -187,6 +193,7 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
     torque_.on_rejoin();
     stuck_.on_rejoin();
     step_.on_rejoin();
+    moving_step_.on_rejoin();
     dropout_.on_rejoin();
   }
   if (!check.usable()) return;  // corrupt: counted by the guard, never used
@@ -196,6 +203,7 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   jump_.update(c, p_, arbiter_);
   stuck_.update(c, p_, arbiter_);
   step_.update(c, p_, arbiter_);
+  moving_step_.update(c, p_, arbiter_);
   if (estimate != nullptr && estimate->valid) {
     residual_.update(r, *estimate, p_, arbiter_, noise_, stuck_, jump_);
   } else if (!arbiter_.ok(Part::Resolver) && arbiter_.ok(Part::LoadCell) && have_prev_ && check.load_cell_present &&

@@ -81,6 +81,15 @@ MonitorParams read_monitor_params(Reader& r) {
   p.step_kN = st.number("step_kN", pos);
   p.step_keep_fraction = st.number("keep_fraction", Range{0.0, 1.0, true, false});
   p.step_confirm_samples = static_cast<int>(st.integer("confirm_samples", 1, 1000));
+  {
+    auto mv = st.map("moving");
+    p.step_moving = mv.boolean("enabled");
+    p.step_moving_window_samples = static_cast<int>(mv.integer("window_samples", 3, MovingStepDetector::kMaxWindow));
+    p.step_moving_quiet_fraction = mv.number("quiet_fraction", pos);
+    p.step_moving_unexplained_rev = mv.number("unexplained_position_rev", pos);
+    p.step_moving_speed_kN_per_rev_per_s = mv.number("speed_kN_per_rev_per_s", config::Range::non_negative());
+    mv.finish();
+  }
   st.finish();
 
   auto n = r.map("noise");

@@ -28,6 +28,7 @@
 #include "bbw/faults/detectors/noise_detector.hpp"
 #include "bbw/faults/detectors/residual_detector.hpp"
 #include "bbw/faults/detectors/stuck_detector.hpp"
+#include "bbw/faults/detectors/moving_step_detector.hpp"
 #include "bbw/faults/detectors/step_detector.hpp"
 #include "bbw/faults/detectors/torque_detector.hpp"
 #include "bbw/faults/detectors/tracking_detector.hpp"
@@ -150,6 +151,18 @@ struct MonitorParams {
   double step_kN = 0.5;
   double step_keep_fraction = 0.6;
   int step_confirm_samples = 5;         // repeats that name the frozen channel of a residual
+  // Moving (MovingStepDetector, with an end-of-line curve and key-friction model, beyond its
+  // contact point): the load cell against the end-of-line curve leaves the straight line through
+  // its last step_moving_window_samples values by step_kN + 4x their spread about it + the key
+  // friction's largest change over the travel + the curve's largest change in the window +
+  // step_moving_speed_kN_per_rev_per_s x the largest speed change; only while that spread is at
+  // most step_moving_quiet_fraction x step_kN, never across a position step the speed does not
+  // explain by step_moving_unexplained_rev. Then kept as the still rule's step: LoadCellOffset.
+  bool step_moving = true;
+  int step_moving_window_samples = 20;
+  double step_moving_quiet_fraction = 0.25;
+  double step_moving_unexplained_rev = 0.003;
+  double step_moving_speed_kN_per_rev_per_s = 0.3;
 
   // Noise: in a window of the residual's sample-to-sample changes, the share larger than
   // noise_step_kN (a single step, e.g. a bias or a resolver jump, is one sample, not noise).
@@ -324,6 +337,7 @@ class FaultMonitor {
   ResidualDetector residual_;
   TorqueDetector torque_;
   StepDetector step_;
+  MovingStepDetector moving_step_;
   TrackingDetector tracking_;
   LinkDetector link_;
   // The previous usable sample (continuity for the detectors; broken by a rejoin).

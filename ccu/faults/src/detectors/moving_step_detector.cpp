@@ -1,0 +1,135 @@
+#include "bbw/faults/detectors/moving_step_detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "bbw/faults/fault_monitor.hpp"
+#include "bbw/plant/key_friction.hpp"
+
+namespace bbw::faults {
+
+MovingStepDetector::MovingStepDetector(const MonitorParams& p) {
+  if (!p.eol_curve || !p.eol_key_friction) return;
+  eol_.emplace(*p.eol_curve);
+  const plant::KeyFriction keys(*p.eol_key_friction);
+  std::vector<std::pair<double, double>> e;  // (swing, stiffness)
+  for (std::size_t i = 0; i < keys.elements(); ++i) e.emplace_back(2.0 * keys.thresholds_rev()[i], keys.stiffness_kN_per_rev()[i]);
+  std::sort(e.begin(), e.end());
+  swing_rev_.resize(e.size());
+  stiffness_from_kN_per_rev_.resize(e.size() + 1, 0.0);
+  for (std::size_t i = e.size(); i-- > 0;) {
+    swing_rev_[i] = e[i].first;
+    stiffness_from_kN_per_rev_[i] = stiffness_from_kN_per_rev_[i + 1] + e[i].second;
+  }
+  backlash_rev_ = p.eol_backlash_rev;
+}
+
+double MovingStepDetector::friction_stiffness_kN_per_rev(double travel_rev) const {
+  // The keys (the spindle) lag the motor by up to the play after a reversal.
+  const double keys_travel_rev = std::max(0.0, travel_rev - backlash_rev_);
+  const auto first = std::upper_bound(swing_rev_.begin(), swing_rev_.end(), keys_travel_rev) - swing_rev_.begin();
+  return stiffness_from_kN_per_rev_[static_cast<std::size_t>(first)];
+}
+
+void MovingStepDetector::update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a) {
+  if (!eol_ || !p.step_moving) return;
+  const CornerReading& r = c.r;
+  if (!c.check.load_cell_present || !c.have_prev || !c.prev_load_cell_present || c.dt_s > p.jump_max_gap_s ||
+      !std::isfinite(r.force_kN) || !std::isfinite(c.prev.force_kN)) {
+    reset();  // a gap: the window restarts
+    return;
+  }
+  const double temperature_C =
+      std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
+  const double eol_kN = eol_->force_kN(r.position_rev, temperature_C, 0.0);
+  const double q = r.force_kN - eol_kN;
+  const double dx = r.position_rev - c.prev.position_rev;
+  // The travel since the last reversal.
+  if (direction_ == 0 || (r.position_rev - extreme_rev_) * direction_ < -kReversalRev) {
+    if (direction_ != 0) turn_rev_ = extreme_rev_;
+    else turn_rev_ = r.position_rev;
+    direction_ = direction_ == 0 ? 1 : -direction_;
+    extreme_rev_ = r.position_rev;
+  }
+  if ((r.position_rev - extreme_rev_) * direction_ > 0.0) extreme_rev_ = r.position_rev;
+  const double travel_rev = std::abs(r.position_rev - turn_rev_);
+  // A position step the measured speed does not explain: the resolver's, not the load cell's.
+  const bool explained = std::abs(dx - r.speed_rev_per_s * c.dt_s) <= p.step_moving_unexplained_rev;
+  // Where the end-of-line curve has the pads on the disc (its contact point at this temperature).
+  const auto& cp = eol_->params();
+  const double contact_rev = cp.contact_rev + cp.contact_shift_rev_per_C * (temperature_C - cp.reference_temperature_C);
+  const bool trusted = r.position_rev >= contact_rev && c.prev.position_rev >= contact_rev;
+  if (!explained || !trusted) {
+    reset();
+    return;
+  }
+  const auto newest = static_cast<std::size_t>((head_ - 1 + kMaxWindow) % kMaxWindow);
+  // The curve's change over this sample (from the window's newest position).
+  const double deol = count_ > 0 ? eol_kN - eol_->force_kN(w_[newest].x_rev, temperature_C, 0.0) : 0.0;
+  if (pending_) {
+    ++kept_;
+    const double dev = q - (level_kN_ + trend_kN_ * kept_);
+    if (dev * step_kN_ > 0.0 && std::abs(dev) >= p.step_keep_fraction * std::abs(step_kN_)) {
+      if (kept_ >= p.step_confirm_samples) {
+        a.confirm(Finding::LoadCellOffset, onset_s_, r.time_s);
+        reset();
+      }
+      return;
+    }
+    reset();  // returned: noise, not a bias
+    return;
+  }
+  const int n = p.step_moving_window_samples;
+  if (count_ >= n) {
+    // A straight line through the window's q (least squares over u = -1 .. -n samples from now):
+    // the level it predicts now, its slope per sample, and the spread about it.
+    double sum_q = 0.0, max_deol = std::abs(deol), max_dv = std::abs(r.speed_rev_per_s - w_[newest].v_rev_per_s);
+    for (int k = 1; k <= n; ++k) {
+      const auto& s = w_[static_cast<std::size_t>((head_ - k + kMaxWindow) % kMaxWindow)];
+      sum_q += s.q_kN;
+      max_deol = std::max(max_deol, std::abs(s.deol_kN));
+      if (k < n) {
+        const auto& older = w_[static_cast<std::size_t>((head_ - k - 1 + kMaxWindow) % kMaxWindow)];
+        max_dv = std::max(max_dv, std::abs(s.v_rev_per_s - older.v_rev_per_s));
+      }
+    }
+    const double u_mean = -(n + 1) / 2.0, q_mean = sum_q / n;
+    double suu = 0.0, suq = 0.0;
+    for (int k = 1; k <= n; ++k) {
+      const auto& s = w_[static_cast<std::size_t>((head_ - k + kMaxWindow) % kMaxWindow)];
+      suu += (-k - u_mean) * (-k - u_mean);
+      suq += (-k - u_mean) * (s.q_kN - q_mean);
+    }
+    const double trend = suq / suu;
+    const double level = q_mean - trend * u_mean;
+    double sse = 0.0;
+    for (int k = 1; k <= n; ++k) {
+      const auto& s = w_[static_cast<std::size_t>((head_ - k + kMaxWindow) % kMaxWindow)];
+      const double d = s.q_kN - (level - trend * k);
+      sse += d * d;
+    }
+    const double spread = std::sqrt(sse / (n - 2));
+    const double dv = max_dv;
+    // The friction's largest change over this sample: from the travel before it.
+    const double k_now = friction_stiffness_kN_per_rev(std::max(0.0, travel_rev - std::abs(dx)));
+    const double friction_kN = k_now * std::abs(dx) + friction_stiffness_kN_per_rev(0.0) * kReversalRev;
+    const double allowance = p.step_kN + kSpreads * spread + friction_kN + max_deol +
+                             p.step_moving_speed_kN_per_rev_per_s * dv;
+    const double e = q - level;
+    if (spread <= p.step_moving_quiet_fraction * p.step_kN && std::abs(e) >= allowance) {
+      pending_ = true;
+      level_kN_ = level;
+      trend_kN_ = trend;
+      step_kN_ = e;
+      onset_s_ = r.time_s;
+      kept_ = 0;
+      count_ = 0;
+      return;
+    }
+  }
+  w_[static_cast<std::size_t>(head_)] = Sample{q, r.position_rev, r.speed_rev_per_s, deol};
+  head_ = (head_ + 1) % kMaxWindow;
+  count_ = std::min(count_ + 1, kMaxWindow);
+}
+
+}  // namespace bbw::faults
