@@ -44,15 +44,19 @@ void MovingStepDetector::update(const SampleContext& c, const MonitorParams& p, 
   const double eol_kN = eol_->force_kN(r.position_rev, temperature_C, 0.0);
   const double q = r.force_kN - eol_kN;
   const double dx = r.position_rev - c.prev.position_rev;
-  // The travel since the last reversal.
-  if (direction_ == 0 || (r.position_rev - extreme_rev_) * direction_ < -kReversalRev) {
-    if (direction_ != 0) turn_rev_ = extreme_rev_;
-    else turn_rev_ = r.position_rev;
-    direction_ = direction_ == 0 ? 1 : -direction_;
-    extreme_rev_ = r.position_rev;
+  // The travel since the last reversal (none known at the start or after a rejoin).
+  const double x = r.position_rev;
+  if (direction_ == 0) {
+    direction_ = 1;
+    turn_rev_ = extreme_rev_ = x;
+  } else if ((x - extreme_rev_) * direction_ < -kReversalRev) {
+    turn_rev_ = extreme_rev_;
+    direction_ = -direction_;
+    extreme_rev_ = x;
+  } else if ((x - extreme_rev_) * direction_ > 0.0) {
+    extreme_rev_ = x;
   }
-  if ((r.position_rev - extreme_rev_) * direction_ > 0.0) extreme_rev_ = r.position_rev;
-  const double travel_rev = std::abs(r.position_rev - turn_rev_);
+  const double travel_rev = std::abs(x - turn_rev_);
   // A position step the measured speed does not explain: the resolver's, not the load cell's.
   const bool explained = std::abs(dx - r.speed_rev_per_s * c.dt_s) <= p.step_moving_unexplained_rev;
   // Where the end-of-line curve has the pads on the disc (its contact point at this temperature).
@@ -64,8 +68,8 @@ void MovingStepDetector::update(const SampleContext& c, const MonitorParams& p, 
     return;
   }
   const auto newest = static_cast<std::size_t>((head_ - 1 + kMaxWindow) % kMaxWindow);
-  // The curve's change over this sample (from the window's newest position).
-  const double deol = count_ > 0 ? eol_kN - eol_->force_kN(w_[newest].x_rev, temperature_C, 0.0) : 0.0;
+  // The curve's change over this sample (from the window's newest sample).
+  const double deol = count_ > 0 ? eol_kN - w_[newest].eol_kN : 0.0;
   if (pending_) {
     ++kept_;
     const double dev = q - (level_kN_ + trend_kN_ * kept_);
@@ -81,27 +85,23 @@ void MovingStepDetector::update(const SampleContext& c, const MonitorParams& p, 
   }
   const int n = p.step_moving_window_samples;
   if (count_ >= n) {
-    // A straight line through the window's q (least squares over u = -1 .. -n samples from now):
-    // the level it predicts now, its slope per sample, and the spread about it.
-    double sum_q = 0.0, max_deol = std::abs(deol), max_dv = std::abs(r.speed_rev_per_s - w_[newest].v_rev_per_s);
+    // A straight line through the window's q (least squares over u = -1 .. -n samples from now,
+    // whose mean is -(n + 1) / 2 and sum of squared deviations n (n^2 - 1) / 12): the level it
+    // predicts now, its slope per sample, and the spread about it.
+    const double u_mean = -(n + 1) / 2.0, suu = n * (static_cast<double>(n) * n - 1.0) / 12.0;
+    double sum_q = 0.0, suq = 0.0, max_deol = std::abs(deol), dv = std::abs(r.speed_rev_per_s - w_[newest].v_rev_per_s);
     for (int k = 1; k <= n; ++k) {
       const auto& s = w_[static_cast<std::size_t>((head_ - k + kMaxWindow) % kMaxWindow)];
       sum_q += s.q_kN;
+      suq += (-k - u_mean) * s.q_kN;
       max_deol = std::max(max_deol, std::abs(s.deol_kN));
       if (k < n) {
         const auto& older = w_[static_cast<std::size_t>((head_ - k - 1 + kMaxWindow) % kMaxWindow)];
-        max_dv = std::max(max_dv, std::abs(s.v_rev_per_s - older.v_rev_per_s));
+        dv = std::max(dv, std::abs(s.v_rev_per_s - older.v_rev_per_s));
       }
     }
-    const double u_mean = -(n + 1) / 2.0, q_mean = sum_q / n;
-    double suu = 0.0, suq = 0.0;
-    for (int k = 1; k <= n; ++k) {
-      const auto& s = w_[static_cast<std::size_t>((head_ - k + kMaxWindow) % kMaxWindow)];
-      suu += (-k - u_mean) * (-k - u_mean);
-      suq += (-k - u_mean) * (s.q_kN - q_mean);
-    }
     const double trend = suq / suu;
-    const double level = q_mean - trend * u_mean;
+    const double level = sum_q / n - trend * u_mean;
     double sse = 0.0;
     for (int k = 1; k <= n; ++k) {
       const auto& s = w_[static_cast<std::size_t>((head_ - k + kMaxWindow) % kMaxWindow)];
@@ -109,7 +109,6 @@ void MovingStepDetector::update(const SampleContext& c, const MonitorParams& p, 
       sse += d * d;
     }
     const double spread = std::sqrt(sse / (n - 2));
-    const double dv = max_dv;
     // The friction's largest change over this sample: from the travel before it.
     const double k_now = friction_stiffness_kN_per_rev(std::max(0.0, travel_rev - std::abs(dx)));
     const double friction_kN = k_now * std::abs(dx) + friction_stiffness_kN_per_rev(0.0) * kReversalRev;
@@ -127,7 +126,7 @@ void MovingStepDetector::update(const SampleContext& c, const MonitorParams& p, 
       return;
     }
   }
-  w_[static_cast<std::size_t>(head_)] = Sample{q, r.position_rev, r.speed_rev_per_s, deol};
+  w_[static_cast<std::size_t>(head_)] = Sample{q, eol_kN, r.speed_rev_per_s, deol};
   head_ = (head_ + 1) % kMaxWindow;
   count_ = std::min(count_ + 1, kMaxWindow);
 }

@@ -40,7 +40,10 @@ class MovingStepDetector {
   static constexpr double kSpreads = 4.0;       // the window's own spread about its line, allowed besides
   explicit MovingStepDetector(const MonitorParams& p);
   void update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a);
-  void on_rejoin() { reset(); }
+  void on_rejoin() {
+    reset();
+    direction_ = 0;  // the travel since the last reversal is no longer known
+  }
   bool pending() const { return pending_; }
   // The end-of-line key friction's largest rate of change (kN/rev) `travel_rev` after a reversal:
   // the elements still sticking (an element goes from one side of its threshold to the other over
@@ -63,7 +66,7 @@ class MovingStepDetector {
   double extreme_rev_ = 0.0;
   double turn_rev_ = 0.0;  // where the last reversal was
   struct Sample {
-    double q_kN, x_rev, v_rev_per_s, deol_kN;
+    double q_kN, eol_kN, v_rev_per_s, deol_kN;
   };
   std::array<Sample, kMaxWindow> w_{};
   int head_ = 0;
