@@ -1226,6 +1226,34 @@ TEST(FaultMonitor, ASlowDriftCannotWidenTheLearntThresholdAsFastAsItGrows) {
   EXPECT_LT(d.detected_s, window_end_s);
 }
 
+namespace {
+
+// The end-of-line caliper of `p` applied to about 20 kN (4.6 rev/s for 1 s) and held until 8 s,
+// its load cell drifting at drift_kN_per_s from 4 s; view(t, load cell, friction, curve) is the
+// calibrator's estimate the monitor gets. Returns the load cell's diagnosis.
+template <class View>
+Diagnosis drift_in_a_hold(const MonitorParams& p, double drift_kN_per_s, View view) {
+  EolCaliper caliper{p};  // the caliper's own keys, from an unknown state
+  auto& [eol, keys, T] = caliper;
+  FaultMonitor m(p, Target::RL);
+  SampleGuard g{MonitorParams{}.guard};
+  double x = 0.0;
+  for (int n = 1; n < 8000; ++n) {
+    const double t = 0.001 * n;
+    const double speed = t < 1.0 ? 4.6 : 0.0;
+    x += 0.001 * speed;
+    const double friction_kN = keys.step(x);
+    const double drift_kN = t > 4.0 ? drift_kN_per_s * (t - 4.0) : 0.0;
+    const double lc = eol.force_kN(x, T, 0.0) + friction_kN + drift_kN + 0.03 * ((n % 5) - 2);
+    const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
+    const auto e = view(t, lc, friction_kN, eol.force_kN(x, T, 0.0));
+    m.update(r, g.check(r), &e, e.force_kN, t);
+  }
+  return m.diagnosis(Part::LoadCell);
+}
+
+}  // namespace
+
 // A drift that starts in a hold before the first fit: the fit, mid-hold, changes how the
 // residual is computed. Restarting the hold there threw away the change the drift had made
 // (tune_bias run 10: 0.5 kN in a held hard stop); rebased, the hold carries it across.
@@ -1233,24 +1261,10 @@ TEST(FaultMonitor, AHoldCarriesADriftsChangeAcrossTheFirstFit) {
   auto run = [](bool rebase, double drift_kN_per_s) {
     MonitorParams p = eol_params(1.5, false);
     p.hold_rebase = rebase;
-    EolCaliper caliper{p};
-    auto& [eol, keys, T] = caliper;
-    FaultMonitor m(p, Target::RL);
-    SampleGuard g{MonitorParams{}.guard};
-    double x = 0.0;
-    for (int n = 1; n < 8000; ++n) {
-      const double t = 0.001 * n;
-      const double speed = t < 1.0 ? 4.6 : 0.0;  // apply to about 20 kN, then hold
-      x += 0.001 * speed;
-      const double friction_kN = keys.step(x);
-      const double drift_kN = t > 4.0 ? drift_kN_per_s * (t - 4.0) : 0.0;
-      const double lc = eol.force_kN(x, T, 0.0) + friction_kN + drift_kN + 0.03 * ((n % 5) - 2);
-      const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
-      // The first fit comes at 5 s, in the hold; before it, the load cell as it is.
-      const auto e = t > 5.0 ? fitted(true, lc, friction_kN, eol.force_kN(x, T, 0.0)) : uncalibrated(lc);
-      m.update(r, g.check(r), &e, e.force_kN, t);
-    }
-    return m.diagnosis(Part::LoadCell);
+    // The first fit comes at 5 s, in the hold; before it, the load cell as it is.
+    return drift_in_a_hold(p, drift_kN_per_s, [](double t, double lc, double friction_kN, double curve_kN) {
+      return t > 5.0 ? fitted(true, lc, friction_kN, curve_kN) : uncalibrated(lc);
+    });
   };
   const double window_end_s = 4.0 + 1.0 / 0.6 + 0.5;
   const auto restarted = run(false, -0.6);
@@ -1267,23 +1281,10 @@ TEST(FaultMonitor, CalibratedAHoldKeepsItsLevelWhileTheLearntStatisticsFollowADr
   auto run = [](bool hold_calibrated, double drift_kN_per_s) {
     MonitorParams p = eol_params(1.5, false);
     p.hold_calibrated = hold_calibrated;
-    EolCaliper caliper{p};  // the caliper's own keys, from an unknown state
-    auto& [eol, keys, T] = caliper;
-    FaultMonitor m(p, Target::RL);
-    SampleGuard g{MonitorParams{}.guard};
-    double x = 0.0;
-    for (int n = 1; n < 8000; ++n) {
-      const double t = 0.001 * n;
-      const double speed = t < 1.0 ? 4.6 : 0.0;  // apply to about 20 kN, then hold
-      x += 0.001 * speed;
-      const double friction_kN = keys.step(x);
-      const double drift_kN = t > 4.0 ? drift_kN_per_s * (t - 4.0) : 0.0;
-      const double lc = eol.force_kN(x, T, 0.0) + friction_kN + drift_kN + 0.03 * ((n % 5) - 2);
-      const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
-      const auto e = fitted(t > 0.5, lc, friction_kN, eol.force_kN(x, T, 0.0));  // its friction right
-      m.update(r, g.check(r), &e, e.force_kN, t);
-    }
-    return m.diagnosis(Part::LoadCell);
+    // Calibrated from 0.5 s, its friction right.
+    return drift_in_a_hold(p, drift_kN_per_s, [](double t, double lc, double friction_kN, double curve_kN) {
+      return fitted(t > 0.5, lc, friction_kN, curve_kN);
+    });
   };
   const double window_end_s = 4.0 + 1.0 / 0.6 + 0.5;
   const auto without = run(false, -0.6);
