@@ -88,44 +88,49 @@ void MovingStepDetector::update(const SampleContext& c, const MonitorParams& p, 
     // A straight line through the window's q (least squares over u = -1 .. -n samples from now,
     // whose mean is -(n + 1) / 2 and sum of squared deviations n (n^2 - 1) / 12): the level it
     // predicts now, its slope per sample, and the spread about it.
+    // The window's sums are kept as samples come and go (sum_q_: of q; sum_kq_: of k q, k the
+    // samples back), so the line costs nothing per sample.
     const double u_mean = -(n + 1) / 2.0, suu = n * (static_cast<double>(n) * n - 1.0) / 12.0;
-    double sum_q = 0.0, suq = 0.0, max_deol = std::abs(deol), dv = std::abs(r.speed_rev_per_s - w_[newest].v_rev_per_s);
-    for (int k = 1; k <= n; ++k) {
-      const auto& s = w_[static_cast<std::size_t>((head_ - k + kMaxWindow) % kMaxWindow)];
-      sum_q += s.q_kN;
-      suq += (-k - u_mean) * s.q_kN;
-      max_deol = std::max(max_deol, std::abs(s.deol_kN));
-      if (k < n) {
-        const auto& older = w_[static_cast<std::size_t>((head_ - k - 1 + kMaxWindow) % kMaxWindow)];
-        dv = std::max(dv, std::abs(s.v_rev_per_s - older.v_rev_per_s));
-      }
-    }
-    const double trend = suq / suu;
-    const double level = sum_q / n - trend * u_mean;
-    double sse = 0.0;
-    for (int k = 1; k <= n; ++k) {
-      const auto& s = w_[static_cast<std::size_t>((head_ - k + kMaxWindow) % kMaxWindow)];
-      const double d = s.q_kN - (level - trend * k);
-      sse += d * d;
-    }
-    const double spread = std::sqrt(sse / (n - 2));
+    const double trend = (-sum_kq_ - u_mean * sum_q_) / suu;
+    const double level = sum_q_ / n - trend * u_mean;
+    const double e = q - level;
     // The friction's largest change over this sample: from the travel before it.
     const double k_now = friction_stiffness_kN_per_rev(std::max(0.0, travel_rev - std::abs(dx)));
     const double friction_kN = k_now * std::abs(dx) + friction_stiffness_kN_per_rev(0.0) * kReversalRev;
+    // The rest of the allowance is never negative: only a candidate needs it (per sample, most do not).
+    double spread = 0.0, max_deol = std::abs(deol), dv = std::abs(r.speed_rev_per_s - w_[newest].v_rev_per_s);
+    const bool candidate = std::abs(e) >= p.step_kN + friction_kN;
+    if (candidate) {
+      double sse = 0.0;
+      for (int k = 1; k <= n; ++k) {
+        const auto& s = w_[static_cast<std::size_t>((head_ - k + kMaxWindow) % kMaxWindow)];
+        const double d = s.q_kN - (level - trend * k);
+        sse += d * d;
+        max_deol = std::max(max_deol, std::abs(s.deol_kN));
+        if (k < n) {
+          const auto& older = w_[static_cast<std::size_t>((head_ - k - 1 + kMaxWindow) % kMaxWindow)];
+          dv = std::max(dv, std::abs(s.v_rev_per_s - older.v_rev_per_s));
+        }
+      }
+      spread = std::sqrt(sse / (n - 2));
+    }
     const double allowance = p.step_kN + kSpreads * spread + friction_kN + max_deol +
                              p.step_moving_speed_kN_per_rev_per_s * dv;
-    const double e = q - level;
-    if (spread <= p.step_moving_quiet_fraction * p.step_kN && std::abs(e) >= allowance) {
+    if (candidate && spread <= p.step_moving_quiet_fraction * p.step_kN && std::abs(e) >= allowance) {
       pending_ = true;
       level_kN_ = level;
       trend_kN_ = trend;
       step_kN_ = e;
       onset_s_ = r.time_s;
       kept_ = 0;
-      count_ = 0;
+      restart_window();
       return;
     }
   }
+  // Every sample in the window moves one further back; the one n back leaves it.
+  const double leaving = count_ >= n ? w_[static_cast<std::size_t>((head_ - n + kMaxWindow) % kMaxWindow)].q_kN : 0.0;
+  sum_kq_ += sum_q_ + q - (count_ >= n ? (n + 1) * leaving : 0.0);
+  sum_q_ += q - leaving;
   w_[static_cast<std::size_t>(head_)] = Sample{q, eol_kN, r.speed_rev_per_s, deol};
   head_ = (head_ + 1) % kMaxWindow;
   count_ = std::min(count_ + 1, kMaxWindow);

@@ -52,8 +52,12 @@ class MovingStepDetector {
 
  private:
   void reset() {
-    count_ = 0;
+    restart_window();
     pending_ = false;
+  }
+  void restart_window() {
+    count_ = 0;
+    sum_q_ = sum_kq_ = 0.0;
   }
   std::optional<plant::ClampCurve> eol_;
   // The elements' full-swing travels (twice their thresholds), ascending, and the sum of the
@@ -71,6 +75,10 @@ class MovingStepDetector {
   std::array<Sample, kMaxWindow> w_{};
   int head_ = 0;
   int count_ = 0;
+  // Over the window's last step.moving.window_samples samples: the sum of q and of k q, k the
+  // samples back (1: the newest).
+  double sum_q_ = 0.0;
+  double sum_kq_ = 0.0;
   bool pending_ = false;
   double level_kN_ = 0.0;  // q the window predicts at the step's sample
   double trend_kN_ = 0.0;  // the line's slope, per sample
