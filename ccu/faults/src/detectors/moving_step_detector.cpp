@@ -22,6 +22,7 @@ MovingStepDetector::MovingStepDetector(const MonitorParams& p) {
     stiffness_from_kN_per_rev_[i] = stiffness_from_kN_per_rev_[i + 1] + e[i].second;
   }
   backlash_rev_ = p.eol_backlash_rev;
+  all_sticking_kN_per_rev_ = stiffness_from_kN_per_rev_.front();
 }
 
 double MovingStepDetector::friction_stiffness_kN_per_rev(double travel_rev) const {
@@ -96,7 +97,7 @@ void MovingStepDetector::update(const SampleContext& c, const MonitorParams& p, 
     const double e = q - level;
     // The friction's largest change over this sample: from the travel before it.
     const double k_now = friction_stiffness_kN_per_rev(std::max(0.0, travel_rev - std::abs(dx)));
-    const double friction_kN = k_now * std::abs(dx) + friction_stiffness_kN_per_rev(0.0) * kReversalRev;
+    const double friction_kN = k_now * std::abs(dx) + all_sticking_kN_per_rev_ * kReversalRev;
     // The rest of the allowance is never negative: only a candidate needs it (per sample, most do not).
     double spread = 0.0, max_deol = std::abs(deol), dv = std::abs(r.speed_rev_per_s - w_[newest].v_rev_per_s);
     const bool candidate = std::abs(e) >= p.step_kN + friction_kN;

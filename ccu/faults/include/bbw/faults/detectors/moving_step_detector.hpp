@@ -65,6 +65,7 @@ class MovingStepDetector {
   std::vector<double> swing_rev_;
   std::vector<double> stiffness_from_kN_per_rev_;
   double backlash_rev_ = 0.0;
+  double all_sticking_kN_per_rev_ = 0.0;  // every element's stiffness: right after a reversal
   // The travel since the last reversal: the direction of motion and the running extreme.
   int direction_ = 0;
   double extreme_rev_ = 0.0;
