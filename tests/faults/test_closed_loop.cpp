@@ -289,6 +289,71 @@ TEST(ClosedLoop, ADriveThatSeizesInAHoldIsFoundByTheActuatorTestBeforeTheRelease
               seized_at_s, 1e3 * (fl.detected_s - seized_at_s), 1e3 * (fl_off.detected_s - seized_at_s));
 }
 
+// Issue 14, thirteenth session: a 60 % torque loss in a held stop. The drive holds the force with
+// little current (and the motor side of FL's backlash settles slowly within the gap), so only
+// the actuator test sees it: the rotor answers about 0.4 of a healthy rotor, too strongly for a
+// dead drive and too weakly for a healthy one. The weak-answer rule names it a torque loss (the
+// corner stays in use); without it nothing is named here. Two weak answers below the unanswered
+// threshold no longer name a lost actuator unless their mean is a dead drive's (tuning seed 1403
+// runs 532, 580, 86: 67-74 % losses named actuator_lost). A total loss at the same moment is
+// still lost.
+TEST(ClosedLoop, AHalfLostMotorInAHoldIsATorqueLossNotALostActuator) {
+  const auto fs = load("config/scenarios/faults/actuator_torque_loss_in_hold.yaml");
+  ASSERT_GT(fs.scenario.controller.hold_test_current_A, 0.0);
+  const double at_s = fs.faults.faults.at(0).at_s;
+  const auto actuator = [](const LoopResult& r, std::size_t c) {
+    return r.diagnoses[c * 5 + static_cast<std::size_t>(Part::Actuator)];
+  };
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct);
+  EXPECT_EQ(r.outcomes[0].diagnosis, Finding::ActuatorTorqueLoss);
+  const Diagnosis fl = actuator(r, 0);
+  ASSERT_TRUE(fl.present);
+  EXPECT_EQ(fl.finding, Finding::ActuatorTorqueLoss);
+  EXPECT_LT(fl.detected_s - at_s, 0.3);
+  EXPECT_EQ(r.faults_raised(), 1u);  // the healthy corners (backlash; viscous friction at 54 C) raise nothing
+
+  auto opts = default_options();
+  opts.monitor.test_pulse_weak_count = 0;
+  const auto base = run_closed_loop(fs, opts);
+  ASSERT_EQ(base.outcomes.size(), 1u);
+  EXPECT_FALSE(base.outcomes[0].detected);
+
+  // The healthy answer is learnt per corner: with the drive's nominal answer set far too low
+  // (0.3 instead of about 0.69), the learnt one still finds the loss as fast; never learning, it is
+  // found only once the answers have sunk further (639 ms) or not at all.
+  auto low = default_options();
+  low.monitor.test_pulse_healthy_ratio = 0.3;
+  const auto learnt = run_closed_loop(fs, low);
+  EXPECT_TRUE(learnt.outcomes[0].detected && learnt.outcomes[0].correct);
+  EXPECT_LT(learnt.outcomes[0].latency_ms, 300.0);
+  EXPECT_EQ(learnt.faults_raised(), 1u);
+  low.monitor.test_pulse_learn_count = 1000000;
+  const auto never = run_closed_loop(fs, low);
+  EXPECT_TRUE(!never.outcomes[0].detected || never.outcomes[0].latency_ms > 500.0) << never.outcomes[0].latency_ms;
+
+  auto dead = fs;
+  dead.faults.faults[0].type = FaultType::TotalLoss;
+  const auto lost = run_closed_loop(dead, default_options());
+  ASSERT_EQ(lost.outcomes.size(), 1u);
+  EXPECT_TRUE(lost.outcomes[0].detected && lost.outcomes[0].correct);
+  EXPECT_EQ(actuator(lost, 0).finding == Finding::ActuatorLost || actuator(lost, 0).finding == Finding::ActuatorNotReleasing, true)
+      << to_string(actuator(lost, 0).finding);
+  // At most one test later than with the lost rule's mean left out: here the first unanswered
+  // pulse straddles the loss (its answer partly a healthy rotor's), so the pair's mean is above
+  // test_pulse_lost_mean_ratio and the third pulse decides (51 instead of 30 ms).
+  auto any_mean = default_options();
+  any_mean.monitor.test_pulse_lost_mean_ratio = any_mean.monitor.test_pulse_answer_ratio;
+  const auto lost_before = run_closed_loop(dead, any_mean);
+  EXPECT_LE(actuator(lost, 0).detected_s, actuator(lost_before, 0).detected_s + 0.0215);
+  EXPECT_LT(actuator(lost, 0).detected_s - at_s, 0.06);
+  std::printf("60 %% torque loss in a hold at %.1f s: %s %.0f ms later; without the weak-answer rule: %s; a total loss: %.0f ms (%.0f ms without the mean)\n",
+              at_s, to_string(fl.finding), 1e3 * (fl.detected_s - at_s),
+              base.outcomes[0].detected ? to_string(base.outcomes[0].diagnosis) : "missed",
+              1e3 * (actuator(lost, 0).detected_s - at_s), 1e3 * (actuator(lost_before, 0).detected_s - at_s));
+}
+
 TEST(ClosedLoop, CorruptSamplesNeverChangeACommandOrAnEstimate) {
   const auto fs = load("config/scenarios/faults/fault_free_stop.yaml");
   const auto clean = run_closed_loop(fs, default_options());

@@ -59,6 +59,8 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(torque_persist_s);
   SAME(torque_lost_threshold); SAME(torque_lost_persist_s);
   SAME(test_pulse_max_speed_rev_per_s); SAME(test_pulse_answer_ratio); SAME(test_pulse_unanswered); SAME(test_pulse_within_s);
+  SAME(test_pulse_lost_mean_ratio); SAME(test_pulse_weak_count); SAME(test_pulse_weak_fraction);
+  SAME(test_pulse_healthy_ratio); SAME(test_pulse_learn_count);
   SAME(tracking_time_constant_s); SAME(tracking_threshold_kN); SAME(tracking_relative); SAME(tracking_persist_s);
   SAME(force_limit_kN); SAME(release_min_speed_rev_per_s); SAME(deadline_s);
 #undef SAME

@@ -119,6 +119,15 @@ void MonitorParams::validate() const {
           test_pulse_answer_ratio, "must be in (0, 1)");
   require(test_pulse_unanswered >= 1, "test_pulse_unanswered", test_pulse_unanswered, "must be >= 1");
   positive("test_pulse_within_s", test_pulse_within_s);
+  require(test_pulse_lost_mean_ratio > 0.0 && test_pulse_lost_mean_ratio <= test_pulse_answer_ratio,
+          "test_pulse_lost_mean_ratio", test_pulse_lost_mean_ratio, "must be in (0, test_pulse_answer_ratio]");
+  require(test_pulse_weak_count >= 0 && test_pulse_weak_count <= 32, "test_pulse_weak_count", test_pulse_weak_count,
+          "must be in [0, 32]");
+  require(test_pulse_weak_fraction > 0.0 && test_pulse_weak_fraction < 1.0, "test_pulse_weak_fraction",
+          test_pulse_weak_fraction, "must be in (0, 1)");
+  require(test_pulse_healthy_ratio > 0.0 && test_pulse_healthy_ratio <= 2.0, "test_pulse_healthy_ratio",
+          test_pulse_healthy_ratio, "must be in (0, 2]");
+  require(test_pulse_learn_count >= 1, "test_pulse_learn_count", test_pulse_learn_count, "must be >= 1");
   positive("torque_check_min_load_kN", torque_check_min_load_kN);
   positive("torque_check_max_speed_rev_per_s", torque_check_max_speed_rev_per_s);
   require(std::isfinite(torque_check_moving_min_speed_rev_per_s) && torque_check_moving_min_speed_rev_per_s >= 0.0,

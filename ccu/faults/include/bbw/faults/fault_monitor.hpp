@@ -240,15 +240,30 @@ struct MonitorParams {
   // least half the test current off 0 and 1.3 test currents apart; every + sample 0.8 of it above
   // every - one), from a rotor at most test_pulse_max_speed_rev_per_s fast: the rotor's speed
   // over it (the fall over the - half less the fall over the + half) against a free rotor's under
-  // that current. Below test_pulse_answer_ratio: not answered; test_pulse_unanswered such, each
-  // within test_pulse_within_s of the last judged pulse: ActuatorLost (a seized drive or a motor
-  // that makes no torque). 0 A: no test. test_pulse_s at most 7 sample periods.
+  // that current. Below test_pulse_answer_ratio: not answered; test_pulse_unanswered such or more
+  // in a row, each within test_pulse_within_s of the last judged pulse, whose answers' mean is
+  // below test_pulse_lost_mean_ratio: ActuatorLost (a seized drive or a motor that makes no
+  // torque answers with its speed noise about 0; a partial loss weakly). 0 A: no test.
+  // test_pulse_s at most 7 sample periods.
+  // Weak answers (issue 14, thirteenth session): the mean of the last test_pulse_weak_count
+  // answers below test_pulse_weak_fraction of the corner's healthy answer, while the mean of the
+  // latest half of them is at least test_pulse_answer_ratio: ActuatorTorqueLoss (the answer
+  // scales with the torque the motor makes); that latest half's mean below
+  // test_pulse_lost_mean_ratio: ActuatorLost (a dead drive's noise, which may answer now and
+  // then at high loads). The healthy answer is learnt per corner,
+  // the mean of the answers that left that window, once test_pulse_learn_count are in; until then
+  // the drive's nominal test_pulse_healthy_ratio. test_pulse_weak_count 0: no such rule.
   double test_pulse_current_A = 0.0;
   double test_pulse_s = 0.003;
   double test_pulse_max_speed_rev_per_s = 0.2;
   double test_pulse_answer_ratio = 0.15;
   int test_pulse_unanswered = 2;
+  double test_pulse_lost_mean_ratio = 0.075;
   double test_pulse_within_s = 0.04;          // each unanswered pulse within this of the last judged one
+  int test_pulse_weak_count = 8;              // at most TorqueDetector::kMaxWeakCount (32)
+  double test_pulse_weak_fraction = 0.65;
+  double test_pulse_healthy_ratio = 0.69;
+  int test_pulse_learn_count = 16;
   // Tracking backstop: the force against a first-order model of the commanded response. A
   // shortfall below both is ActuatorTracking; an excess above both (a brake that does not
   // release) is ActuatorNotReleasing, with the same threshold and persistence.

@@ -29,6 +29,8 @@ class TorqueDetector {
   // The longest test pulse half the history holds, in samples (two halves and the samples before).
   static constexpr int kMaxPulseSamples = 7;
   static constexpr int kHistory = 2 * kMaxPulseSamples + 2;
+  // The most test answers the weak-answer rule averages (MonitorParams::test_pulse_weak_count).
+  static constexpr int kMaxWeakCount = 32;
   void on_rejoin() {
     torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = static_init_ = false;
     speed_repeats_ = 0;
@@ -64,8 +66,12 @@ class TorqueDetector {
   void reset_response() {
     response_count_ = 0;
     unanswered_ = 0;
+    answers_count_ = 0;
   }
   void update_response(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a);
+  // The weak-answer rule: the mean of the last test_pulse_weak_count answers against the corner's
+  // healthy answer (MonitorParams::test_pulse_weak_fraction).
+  void judge_answers(double ratio, double pulse_start_s, double now_s, const MonitorParams& p, DiagnosisArbiter& a);
   std::array<double, kHistory> response_speed_{};
   std::array<double, kHistory> response_current_{};
   int response_count_ = 0;  // consecutive samples held (up to the array's size)
@@ -74,7 +80,18 @@ class TorqueDetector {
   int unanswered_ = 0;
   int pulse_samples_ = 0;  // a pulse recognised at this sample: its samples, else 0
   double unanswered_since_s_ = 0.0;
+  double unanswered_sum_ = 0.0;  // the answers of the pulses not answered in a row
   double last_pulse_s_ = 0.0;  // when the last pulse was judged
+  // The last test_pulse_weak_count answers (a ring), and the corner's own healthy answer learnt
+  // from the answers that left it (their mean; the drive's nominal answer until enough are in).
+  std::array<double, kMaxWeakCount> answers_{};
+  std::array<double, kMaxWeakCount> answers_start_s_{};  // when each answer's pulse began
+  int answers_head_ = 0;
+  int answers_count_ = 0;
+  double learnt_sum_ = 0.0;
+  int learnt_count_ = 0;
+  bool weak_suspect_ = false;
+  double weak_onset_s_ = 0.0;
   // The seized-in-a-hold rule: where and when the drive stopped, the least made torque since.
   bool static_init_ = false;
   double static_position_rev_ = 0.0;
