@@ -333,6 +333,19 @@ TEST(ClosedLoop, AHalfLostMotorInAHoldIsATorqueLossNotALostActuator) {
   const auto never = run_closed_loop(fs, low);
   EXPECT_TRUE(!never.outcomes[0].detected || never.outcomes[0].latency_ms > 500.0) << never.outcomes[0].latency_ms;
 
+  // Once named, the drive is judged as the weaker drive it is: a 67 % loss stays a torque loss
+  // through the release (the lost rules look for a further loss); judged against the healthy
+  // drive it is named lost at the release, when the loop drives the weak motor back.
+  auto weaker = fs;
+  weaker.faults.faults[0].torque_loss_percent = 67.0;
+  const auto kept = run_closed_loop(weaker, default_options());
+  EXPECT_EQ(actuator(kept, 0).finding, Finding::ActuatorTorqueLoss);
+  auto healthy_model = default_options();
+  healthy_model.monitor.torque_loss_rescales_drive = false;
+  const auto upgraded = run_closed_loop(weaker, healthy_model);
+  EXPECT_EQ(actuator(upgraded, 0).finding, Finding::ActuatorLost);
+  EXPECT_GT(actuator(upgraded, 0).finding_s, 6.0);  // at the release (6.0-6.5 s)
+
   auto dead = fs;
   dead.faults.faults[0].type = FaultType::TotalLoss;
   const auto lost = run_closed_loop(dead, default_options());

@@ -1,5 +1,6 @@
 #include "bbw/faults/detectors/torque_detector.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "bbw/faults/fault_monitor.hpp"
@@ -50,7 +51,8 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
                          make_Nm_ >= p.torque_check_min_torque_Nm;
   const double fraction = !checkable ? 1.0 : applying ? (need_Nm_ + friction_Nm_) / make_Nm_ : need_Nm_ / make_Nm_;
   if (checkable) fraction_ = fraction;
-  if (checkable && fraction < p.torque_lost_threshold) {
+  // Lost: against the drive as it now is (after a named torque loss, its remaining torque).
+  if (checkable && fraction / motor_scale_ < p.torque_lost_threshold) {
     if (!lost_suspect_) {
       lost_suspect_ = true;
       lost_onset_s_ = t;
@@ -109,10 +111,14 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
                           make_Nm_ - static_min_make_Nm_ >= p.seized_ramp_Nm;
   // Pushing: beyond the band and less than the lost threshold of it needed (a partial torque
   // loss the loop absorbs is not a lost actuator), or winding up against a seized drive.
-  const bool pushing = make_Nm_ - need_hi_Nm_ > band &&
-                       (need_hi_Nm_ + p.drive.coulomb_friction_Nm < p.torque_lost_threshold * make_Nm_ || winding_up);
+  // (After a named torque loss the motor makes motor_scale_ of it, either way: each rule takes the
+  // one of the two made torques that makes it the less likely, so only a further loss is named.)
+  const double weak_Nm = make_Nm_ * motor_scale_;
+  const double push_Nm = std::min(make_Nm_, weak_Nm), pull_Nm = std::max(make_Nm_, weak_Nm);
+  const bool pushing = push_Nm - need_hi_Nm_ > band &&
+                       (need_hi_Nm_ + p.drive.coulomb_friction_Nm < p.torque_lost_threshold * push_Nm || winding_up);
   // Pulling: beyond the band plus the whole load (a gear in its backlash gap carries none of it).
-  const bool pulling = need_lo_Nm_ - make_Nm_ > band + load_Nm;
+  const bool pulling = need_lo_Nm_ - pull_Nm > band + load_Nm;
   if (slow && (pushing || pulling)) {
     if (!unexplained_suspect_) {
       unexplained_suspect_ = true;
@@ -128,7 +134,10 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
       torque_suspect_ = true;
       torque_onset_s_ = t;
     }
-    if (t - torque_onset_s_ >= p.torque_persist_s) a.confirm(Finding::ActuatorTorqueLoss, torque_onset_s_, t);
+    if (t - torque_onset_s_ >= p.torque_persist_s) {
+      a.confirm(Finding::ActuatorTorqueLoss, torque_onset_s_, t);
+      rescale_after_torque_loss(fraction, p, a);
+    }
   } else {
     torque_suspect_ = false;
   }
@@ -244,9 +253,16 @@ void TorqueDetector::judge_answers(double ratio, double pulse_start_s, double no
       weak_onset_s_ = pulse_start_s;
     }
     a.confirm(Finding::ActuatorTorqueLoss, weak_onset_s_, now_s);
+    rescale_after_torque_loss(recent / reference, p, a);
   } else {
     weak_suspect_ = false;
   }
+}
+
+void TorqueDetector::rescale_after_torque_loss(double remaining, const MonitorParams& p, const DiagnosisArbiter& a) {
+  const Diagnosis& d = a.diagnosis(Part::Actuator);
+  if (!p.torque_loss_rescales_drive || motor_scale_ != 1.0 || !d.active || d.finding != Finding::ActuatorTorqueLoss) return;
+  motor_scale_ = std::clamp(remaining, p.torque_lost_threshold, 1.0);
 }
 
 }  // namespace bbw::faults

@@ -212,6 +212,15 @@ struct MonitorParams {
   double torque_persist_s = 0.04;
   double torque_lost_threshold = 0.25;        // at any speed, below this: the actuator is lost
   double torque_lost_persist_s = 0.015;
+  // Once a torque loss is named, the drive is judged as the weaker drive it now is (issue 14,
+  // thirteenth session): the lost rules may take the made torque scaled by the remaining fraction
+  // estimated when the loss was named (the torque balance's fraction, or the actuator test's
+  // answers against the corner's healthy one; within [torque_lost_threshold, 1]), and each takes
+  // whichever of the two (scaled or not) makes it the less likely: so they name a further loss,
+  // not the one already named (a 56 % loss named lost 4.3 s later while the motor crossed a
+  // backlash gap: tune_b run 488), and nothing becomes more likely (scaled both ways, a positive
+  // torque slowing a rotor that moved back looked like pulling: tune run 17).
+  bool torque_loss_rescales_drive = true;
   // Unexplained torque (issue 14: a seized drive or a motor that makes no torque, at any load):
   // near standstill, the measured current's torque against what the load, the acceleration and
   // the drive's friction need. Pushing: make - need > drive.coulomb_friction_Nm + unexplained_margin_Nm
