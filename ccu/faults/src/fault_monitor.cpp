@@ -27,6 +27,7 @@ void MonitorParams::validate() const {
   positive("residual_change_threshold_kN", residual_change_threshold_kN);
   positive("residual_sigma_factor", residual_sigma_factor);
   positive("residual_stats_s", residual_stats_s);
+  positive("residual_stats_prior_s", residual_stats_prior_s);
   require(std::isfinite(residual_speed_free_rev_per_s) && residual_speed_free_rev_per_s >= 0.0,
           "residual_speed_free_rev_per_s", residual_speed_free_rev_per_s, "must be >= 0");
   require(std::isfinite(residual_speed_kN_per_rev_per_s) && residual_speed_kN_per_rev_per_s >= 0.0,

@@ -29,6 +29,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.residual_change_threshold_kN = res.number("change_threshold_kN", pos);
   p.residual_sigma_factor = res.number("sigma_factor", pos);
   p.residual_stats_s = res.number("stats_s", pos);
+  p.residual_stats_prior_s = res.number("stats_prior_s", pos);
   p.residual_stats_clip = res.number("stats_clip", config::Range::non_negative());
   p.residual_speed_kN_per_rev_per_s = res.number("speed_kN_per_rev_per_s", config::Range::non_negative());
   p.residual_speed_free_rev_per_s = res.number("speed_free_rev_per_s", config::Range::non_negative());

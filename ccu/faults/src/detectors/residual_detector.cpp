@@ -137,6 +137,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       ms_residual_kN2_ = std::pow(start_kN / p.residual_sigma_factor, 2);
       ms_change_kN2_ = std::pow(std::max(p.residual_change_threshold_kN, eol_ ? start_kN : 0.0) / p.residual_sigma_factor, 2);
       stats_time_s_ = t;
+      stats_learnt_s_ = 0.0;
     }
     thr = std::max(p.residual_threshold_kN, p.residual_sigma_factor * std::max(fit_rms_kN_, std::sqrt(ms_residual_kN2_)));
     change_thr = std::max(p.residual_change_threshold_kN, p.residual_sigma_factor * std::max(fit_rms_kN_, std::sqrt(ms_change_kN2_)));
@@ -245,7 +246,12 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
                     (std::abs(residual_kN_) > thr || (change_rule && std::abs(change_kN_) > change_thr) || hold_over);
   if (!over && !eol_here && e.calibrated && std::isfinite(ms_residual_kN2_) && std::isfinite(change_kN_)) {
     // Healthy: the corner's own residual statistics follow (never while suspected).
-    const double w = -std::expm1(-std::max(0.0, t - stats_time_s_) / p.residual_stats_s);
+    // A running mean of the start (weighing residual_stats_prior_s) and the samples until they
+    // span residual_stats_s, exponential over residual_stats_s after.
+    const double dt = std::max(0.0, t - stats_time_s_);
+    const double span_s = p.residual_stats_prior_s + stats_learnt_s_;
+    const double w = span_s < p.residual_stats_s ? dt / (span_s + dt) : -std::expm1(-dt / p.residual_stats_s);
+    stats_learnt_s_ += dt;
     // Each sample's share is bounded at stats_clip sigmas of what was learnt so far: a slow
     // load-cell drift stays under the threshold while it grows, and learning its square in full
     // widened the threshold as fast as the residual grew (tune_bias run 38: a -1.27 kN/s drift in

@@ -56,6 +56,12 @@ struct MonitorParams {
   // over residual_stats_s, updated only while nothing is suspected. docs/faults.md, "Thresholds".
   double residual_sigma_factor = 4.0;
   double residual_stats_s = 5.0;
+  // The starting value (the end-of-line band) weighs as this much healthy residual (issue 14,
+  // thirteenth session): the learning is the running mean of the start and the samples until
+  // they span residual_stats_s, exponential over residual_stats_s after. (Exponential from the
+  // start, the band took about 15 s to fall to a well-fitted corner's 4 sigma: drifts after the
+  // first fit met thresholds of 1.3-1.8 kN. residual_stats_prior_s >= residual_stats_s: that.)
+  double residual_stats_prior_s = 0.5;
   // A sample adds at most residual_stats_clip^2 times the learnt mean square (0: no bound), so a
   // slow fault under the threshold cannot widen it as fast as it grows.
   double residual_stats_clip = 1.5;

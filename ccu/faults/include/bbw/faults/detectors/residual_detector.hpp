@@ -88,6 +88,7 @@ class ResidualDetector {
   double ms_residual_kN2_ = std::numeric_limits<double>::quiet_NaN();
   double ms_change_kN2_ = std::numeric_limits<double>::quiet_NaN();
   double stats_time_s_ = 0.0;
+  double stats_learnt_s_ = 0.0;  // healthy time learnt since the statistics started
   double stats_clip_moment_ = 1.0;  // E[min(X^2, stats_clip^2)], X a unit Gaussian
   std::optional<plant::ClampCurve> eol_;
   // The caliper's end-of-line key-friction model (Maxwell-slip elements as its production line
