@@ -122,8 +122,9 @@ void MonitorParams::validate() const {
   positive("test_pulse_within_s", test_pulse_within_s);
   require(test_pulse_lost_mean_ratio > 0.0 && test_pulse_lost_mean_ratio <= test_pulse_answer_ratio,
           "test_pulse_lost_mean_ratio", test_pulse_lost_mean_ratio, "must be in (0, test_pulse_answer_ratio]");
-  require(test_pulse_weak_count >= 0 && test_pulse_weak_count <= 32, "test_pulse_weak_count", test_pulse_weak_count,
-          "must be in [0, 32]");
+  require(test_pulse_weak_count >= 0 && test_pulse_weak_count <= TorqueDetector::kMaxWeakCount, "test_pulse_weak_count",
+          test_pulse_weak_count, "must be in [0, TorqueDetector::kMaxWeakCount (32)]");
+  static_assert(TorqueDetector::kMaxWeakCount == 32, "the rule's text above names it");
   require(test_pulse_weak_fraction > 0.0 && test_pulse_weak_fraction < 1.0, "test_pulse_weak_fraction",
           test_pulse_weak_fraction, "must be in (0, 1)");
   require(test_pulse_healthy_ratio > 0.0 && test_pulse_healthy_ratio <= 2.0, "test_pulse_healthy_ratio",

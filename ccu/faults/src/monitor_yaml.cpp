@@ -120,7 +120,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.test_pulse_unanswered = static_cast<int>(t.integer("test_pulse_unanswered", 1, 1000));
   p.test_pulse_within_s = t.number("test_pulse_within_s", pos);
   p.test_pulse_lost_mean_ratio = t.number("test_pulse_lost_mean_ratio", Range{0.0, 1.0, true, true});
-  p.test_pulse_weak_count = static_cast<int>(t.integer("test_pulse_weak_count", 0, 32));
+  p.test_pulse_weak_count = static_cast<int>(t.integer("test_pulse_weak_count", 0, TorqueDetector::kMaxWeakCount));
   p.test_pulse_weak_fraction = t.number("test_pulse_weak_fraction", Range{0.0, 1.0, true, true});
   p.test_pulse_healthy_ratio = t.number("test_pulse_healthy_ratio", Range{0.0, 2.0, true, false});
   p.test_pulse_learn_count = static_cast<int>(t.integer("test_pulse_learn_count", 1, 1000000));

@@ -275,7 +275,7 @@ struct MonitorParams {
   int test_pulse_unanswered = 2;
   double test_pulse_lost_mean_ratio = 0.075;
   double test_pulse_within_s = 0.04;          // each unanswered pulse within this of the last judged one
-  int test_pulse_weak_count = 8;              // at most TorqueDetector::kMaxWeakCount (32)
+  int test_pulse_weak_count = 8;              // at most TorqueDetector::kMaxWeakCount
   double test_pulse_weak_fraction = 0.65;
   double test_pulse_healthy_ratio = 0.69;
   int test_pulse_learn_count = 16;
