@@ -72,8 +72,8 @@ class TorqueDetector {
   // The weak-answer rule: the mean of the last test_pulse_weak_count answers against the corner's
   // healthy answer (MonitorParams::test_pulse_weak_fraction).
   void judge_answers(double ratio, double pulse_start_s, double now_s, const MonitorParams& p, DiagnosisArbiter& a);
-  // After a torque loss is named (MonitorParams::torque_loss_rescales_drive): the made torque is
-  // scaled by the remaining fraction estimated then, once.
+  // After a torque loss is named (MonitorParams::torque_loss_rescales_drive): the remaining
+  // fraction estimated then, once; the lost rules may judge the made torque scaled by it.
   void rescale_after_torque_loss(double remaining, const MonitorParams& p, const DiagnosisArbiter& a);
   double motor_scale_ = 1.0;
   std::array<double, kHistory> response_speed_{};
