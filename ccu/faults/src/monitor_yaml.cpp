@@ -128,6 +128,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.torque_lost_threshold = t.number("lost_threshold", Range{0.0, 1.0, true, true});
   p.torque_lost_persist_s = t.number("lost_persist_s", pos);
   p.torque_loss_rescales_drive = t.boolean("loss_rescales_drive");
+  p.torque_lost_unmeasured_load_high = t.boolean("lost_unmeasured_load_high");
   p.unexplained_margin_Nm = t.number("unexplained_margin_Nm", pos);
   p.unexplained_relative = t.number("unexplained_relative", Range::closed(0.0, 10.0));
   p.unexplained_max_speed_rev_per_s = t.number("unexplained_max_speed_rev_per_s", pos);

@@ -227,6 +227,11 @@ struct MonitorParams {
   // backlash gap: tune_b run 488), and nothing becomes more likely (scaled both ways, a positive
   // torque slowing a rotor that moved back looked like pulling: tune run 17).
   bool torque_loss_rescales_drive = true;
+  // A load not measured (the load cell diagnosed: the force estimate is a curve) is taken at
+  // the top of its plausible range (the end-of-line curve's with the key friction's width and
+  // the curve's band) by the lost rule (fourteenth session: a healthy drive decelerated against
+  // more load than an uncalibrated curve says looked as if its torque went nowhere).
+  bool torque_lost_unmeasured_load_high = true;
   // Unexplained torque (issue 14: a seized drive or a motor that makes no torque, at any load):
   // near standstill, the measured current's torque against what the load, the acceleration and
   // the drive's friction need. Pushing: make - need > drive.coulomb_friction_Nm + unexplained_margin_Nm
