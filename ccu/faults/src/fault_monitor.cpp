@@ -84,6 +84,7 @@ void MonitorParams::validate() const {
   require(std::isfinite(noise_learned_factor) && noise_learned_factor >= 0.0, "noise_learned_factor",
           noise_learned_factor, "must be finite and >= 0");
   positive("noise_learn_time_constant_s", noise_learn_time_constant_s);
+  positive("noise_second_difference_learn_s", noise_second_difference_learn_s);
   require(noise_min_fraction > 0.0 && noise_min_fraction <= 1.0, "noise_min_fraction", noise_min_fraction,
           "must be in (0, 1]");
   require(dropout_samples >= 1, "dropout_samples", dropout_samples, "must be >= 1");
@@ -215,6 +216,11 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   stuck_.update(c, p_, arbiter_);
   step_.update(c, p_, arbiter_);
   moving_step_.update(c, p_, arbiter_);
+  if (arbiter_.ok(Part::Resolver)) {
+    residual_.track_position(r, p_);
+  } else {
+    residual_.forget_position();
+  }
   if (estimate != nullptr && estimate->valid) {
     residual_.update(r, *estimate, p_, arbiter_, noise_, stuck_, jump_);
   } else if (!arbiter_.ok(Part::Resolver) && arbiter_.ok(Part::LoadCell) && have_prev_ && check.load_cell_present &&

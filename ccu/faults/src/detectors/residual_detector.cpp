@@ -26,29 +26,31 @@ ResidualDetector::ResidualDetector(const MonitorParams& p)
   }
 }
 
+void ResidualDetector::track_position(const CornerReading& r, const MonitorParams& p) {
+  if (!eol_friction_) return;
+  // Every element's state is known once the position has risen (or fallen) by twice its
+  // threshold from a low (high) point: from there it slips, whatever it was before.
+  // On a caliper with backlash the keys move with the spindle, which the motor's resolver
+  // drags along within half the play (the play's state is known after the same sweep).
+  if (!have_x_) {
+    have_x_ = true;
+    spindle_rev_ = r.position_rev;
+    eol_friction_->reset(r.position_rev);
+    x_min_rev_ = x_max_rev_ = r.position_rev;
+  }
+  if (p.eol_backlash_rev > 0.0) model::play_step(spindle_rev_, r.position_rev, p.eol_backlash_rev);
+  else spindle_rev_ = r.position_rev;
+  eol_friction_kN_ = eol_friction_->step(spindle_rev_);
+  x_min_rev_ = std::min(x_min_rev_, r.position_rev);
+  x_max_rev_ = std::max(x_max_rev_, r.position_rev);
+  const double sweep_rev = sweep_rev_ + p.eol_backlash_rev;
+  if (r.position_rev - x_min_rev_ >= sweep_rev || x_max_rev_ - r.position_rev >= sweep_rev) friction_known_ = true;
+}
+
 void ResidualDetector::update(const CornerReading& r, const calibration::Estimate& e, const MonitorParams& p,
                               DiagnosisArbiter& a, NoiseDetector& noise, const StuckDetector& stuck,
                               const JumpDetector& jump) {
   const double t = r.time_s;
-  if (eol_friction_) {
-    // Every element's state is known once the position has risen (or fallen) by twice its
-    // threshold from a low (high) point: from there it slips, whatever it was before.
-    // On a caliper with backlash the keys move with the spindle, which the motor's resolver
-    // drags along within half the play (the play's state is known after the same sweep).
-    if (!have_x_) {
-      have_x_ = true;
-      spindle_rev_ = r.position_rev;
-      eol_friction_->reset(r.position_rev);
-      x_min_rev_ = x_max_rev_ = r.position_rev;
-    }
-    if (p.eol_backlash_rev > 0.0) model::play_step(spindle_rev_, r.position_rev, p.eol_backlash_rev);
-    else spindle_rev_ = r.position_rev;
-    eol_friction_kN_ = eol_friction_->step(spindle_rev_);
-    x_min_rev_ = std::min(x_min_rev_, r.position_rev);
-    x_max_rev_ = std::max(x_max_rev_, r.position_rev);
-    const double sweep_rev = sweep_rev_ + p.eol_backlash_rev;
-    if (r.position_rev - x_min_rev_ >= sweep_rev || x_max_rev_ - r.position_rev >= sweep_rev) friction_known_ = true;
-  }
   residual_kN_ = e.force_kN - e.curve_force_kN;
   // The end-of-line curve where the keys and pads are (the spindle, once the friction model's
   // state is known; else the motor) at the measured temperature: evaluated once per sample for

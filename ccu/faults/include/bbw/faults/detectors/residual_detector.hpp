@@ -27,6 +27,19 @@ struct MonitorParams;
 class ResidualDetector {
  public:
   explicit ResidualDetector(const MonitorParams& p);
+  // Steps the end-of-line friction model with every usable sample whose position is trusted,
+  // whether or not the residual is judged (update() needs the calibrator's estimate, which a
+  // load-cell dropout stops): a model left where the dropout began put the friction's whole
+  // width into the residual when the load cell came back after the position had reversed
+  // (tuning seed 1401 run 244: load_cell_offset 20 ms after a 1.9 s dropout cleared).
+  void track_position(const CornerReading& r, const MonitorParams& p);
+  // The position is not trusted (the resolver diagnosed): the friction model's state is lost
+  // with it and is found again by sweeping once the position is back.
+  void forget_position() {
+    friction_known_ = false;
+    have_x_ = false;
+  }
+  // Call track_position() first with the same sample.
   void update(const CornerReading& r, const calibration::Estimate& e, const MonitorParams& p, DiagnosisArbiter& a,
               NoiseDetector& noise, const StuckDetector& stuck, const JumpDetector& jump);
   void on_rejoin() {
