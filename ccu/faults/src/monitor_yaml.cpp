@@ -100,6 +100,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.noise_second_difference_kN = n.number("second_difference_kN", pos);
   p.noise_learned_factor = n.number("learned_factor", Range{0.0, 100.0, true, true});
   p.noise_learn_time_constant_s = n.number("learn_time_constant_s", pos);
+  p.noise_second_difference_learn_s = n.number("second_difference_learn_s", pos);
   n.finish();
 
   auto d = r.map("dropout");

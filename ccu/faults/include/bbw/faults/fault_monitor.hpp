@@ -189,6 +189,11 @@ struct MonitorParams {
   // one it is about 0.36 kN). 0: the fixed step only.
   double noise_learned_factor = 4.0;
   double noise_learn_time_constant_s = 1.0;
+  // Without a residual (the resolver diagnosed), the load cell's own second differences teach
+  // their level too; it counts after this much learning (a burst is found by the fixed
+  // noise_second_difference_kN within a window, 32 ms, before it could be learnt; a healthy 0.08 kN
+  // load cell crosses that threshold in 7 % of samples and was named noisy within 0.25 s).
+  double noise_second_difference_learn_s = 0.1;
 
   // Dropout: consecutive samples without a load-cell value.
   int dropout_samples = 5;

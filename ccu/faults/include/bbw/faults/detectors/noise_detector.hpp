@@ -21,7 +21,8 @@ class NoiseDetector {
  public:
   void update(double residual_kN, double model_kN, double t, const MonitorParams& p, DiagnosisArbiter& a);
   // Without a residual (the resolver is diagnosed): the load cell's first difference F[k] - F[k-1];
-  // its change, the second difference, counts as big beyond noise_second_difference_kN.
+  // its change, the second difference, counts as big beyond noise_second_difference_kN, or
+  // beyond the corner's own learnt level (from its residual before, and from these differences).
   void update_load_cell_difference(double difference_kN, double t, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() { have_prev_residual_ = have_prev_difference_ = false; }
   double fraction() const { return fraction_; }
@@ -38,10 +39,19 @@ class NoiseDetector {
   int head_ = 0;
   int big_count_ = 0;
   double fraction_ = 0.0;  // share of big steps in the window
-  double mean_abs_step_kN_ = 0.0;  // learnt from 0: the fixed step alone until it has grown
-  bool have_learn_time_ = false;
-  double learnt_s_ = 0.0;  // time learnt so far
-  double learn_time_s_ = 0.0;
+  // A healthy level learnt while the window is below a finding: the plain mean until the time
+  // constant is reached, then exponential; it counts once a whole time constant was learnt (a
+  // burst early in the run must not be learnt as the healthy level before it is seen).
+  struct LearntLevel {
+    double mean_kN = 0.0;  // learnt from 0: the fixed step alone until it has grown
+    bool have_time = false;
+    double learnt_s = 0.0;  // time learnt so far
+    double time_s = 0.0;
+    void learn(double value_kN, double t, bool quiet, double time_constant_s);
+    bool learnt(double time_constant_s) const { return learnt_s >= time_constant_s; }
+  };
+  LearntLevel step_level_;    // the residual's |first difference|
+  LearntLevel second_level_;  // the load cell's |second difference| (without a residual)
 };
 
 }  // namespace bbw::faults
