@@ -38,6 +38,7 @@ void ControllerParams::validate() const {
   positive("max_speed_rev_per_s", max_speed_rev_per_s);
   positive("force_bandwidth_rad_per_s", force_bandwidth_rad_per_s);
   non_negative("force_integral_rad_per_s2", force_integral_rad_per_s2);
+  non_negative("force_integral_max_speed_error_rev_per_s", force_integral_max_speed_error_rev_per_s);
   positive("stiffness_at_zero_kN_per_rev", stiffness_at_zero_kN_per_rev);
   non_negative("stiffness_per_kN_per_rev", stiffness_per_kN_per_rev);
   non_negative("release_force_kN", release_force_kN);
@@ -199,7 +200,9 @@ ControllerOutput LocalController::update_force(double force_command_kN, const Co
   ControllerOutput out = speed_loop(v_ref, 0.0, in, dt_s);
   const bool clipped = v_ref != unclipped || out.saturated;
   const double push = unclipped - v_ref + (out.saturated ? out.current_command_A : 0.0);
-  if (!clipped || (push > 0.0 && e < 0.0) || (push < 0.0 && e > 0.0)) {
+  const bool following = !(p_.force_integral_max_speed_error_rev_per_s > 0.0) ||
+                         std::abs(v_ref - in.speed_rev_per_s) <= p_.force_integral_max_speed_error_rev_per_s;
+  if (following && (!clipped || (push > 0.0 && e < 0.0) || (push < 0.0 && e > 0.0))) {
     s_.force_integral_kN_s += e * dt_s;
   }
   out.saturated = clipped;

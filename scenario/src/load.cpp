@@ -158,6 +158,8 @@ corner_unit::ControllerParams read_controller(Reader& c) {
       c.number_or("force_bandwidth_rad_per_s", p.force_bandwidth_rad_per_s, Range::positive());
   p.force_integral_rad_per_s2 =
       c.number_or("force_integral_rad_per_s2", p.force_integral_rad_per_s2, Range::non_negative());
+  p.force_integral_max_speed_error_rev_per_s = c.number_or(
+      "force_integral_max_speed_error_rev_per_s", p.force_integral_max_speed_error_rev_per_s, Range::non_negative());
   p.stiffness_at_zero_kN_per_rev =
       c.number_or("stiffness_at_zero_kN_per_rev", p.stiffness_at_zero_kN_per_rev, Range::positive());
   p.stiffness_per_kN_per_rev =
