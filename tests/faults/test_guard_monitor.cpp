@@ -231,6 +231,38 @@ TEST(FaultMonitor, AResolverJumpIsAnOffsetUnlessItIsUndone) {
   EXPECT_NEAR(offset.diagnosis(Part::Resolver).onset_s, 0.050, 1e-9);
 }
 
+// A position step is explained anywhere between what the two measured speeds give: a drive that
+// seizes at its 25 rev/s limit stops within one sample (its step 0.024 rev, the trapezoid's
+// prediction 0.0125 rev: a seized drive was named resolver_offset, stress seed 1406 run 360); a
+// 0.02 rev offset while it runs at 25 rev/s is still one.
+TEST(FaultMonitor, ARotorThatStopsWithinOneSampleIsNoResolverJump) {
+  auto run = [](bool seize, double offset_rev) {
+    MonitorParams p = noiseless();
+    FaultMonitor m(p, Target::RR);
+    SampleCheck ok;
+    double x = 2.0;
+    for (int k = 1; k < 100; ++k) {
+      const double t = 0.001 * k;
+      double v = 25.0;
+      if (seize && k == 50) {
+        x += 0.024;  // stopped at the end of the sample
+        v = 0.0;
+      } else if (seize && k > 50) {
+        v = 0.0;
+      } else {
+        x += 0.025;
+      }
+      auto r = at(static_cast<std::uint64_t>(k), t, x + (k >= 50 ? offset_rev : 0.0));
+      r.speed_rev_per_s = v;
+      m.update(r, ok, nullptr, 5.0, t);
+    }
+    return m.diagnosis(Part::Resolver);
+  };
+  EXPECT_FALSE(run(true, 0.0).present) << to_string(run(true, 0.0).finding);
+  EXPECT_EQ(run(false, 0.02).finding, Finding::ResolverOffset);
+  EXPECT_EQ(run(false, -0.02).finding, Finding::ResolverOffset);
+}
+
 TEST(FaultMonitor, StuckChannelsNeedTheOtherChannelToMove) {
   MonitorParams p = noiseless();
   SampleCheck ok;
