@@ -587,12 +587,13 @@ TEST(ClosedLoopIssue14, AfterADropoutAcrossAReversalTheFrictionModelStillKnowsIt
 }
 
 // A corner driven on its initial curve after a load-cell finding (13 % high on this caliper)
-// backs its 37 kN hold off slower than its loop asks; its force integral no longer learns while
-// the rotor cannot follow its speed reference, so the release to 3 kN stops at the pads: no
-// actuator finding and the brake never off while 2 kN or more is commanded. Learning regardless
-// (the controller before, tuning seed 1408 run 94), the release ran 1.9 rev past the pads and the
-// CCU named the healthy actuator actuator_tracking.
-TEST(ClosedLoopIssue14, AReleaseOnTheCurveAfterALoadCellFindingStopsAtThePads) {
+// backs its 37 kN hold off slower than its loop asks. With the controller option
+// force_integral_max_speed_error_rev_per_s (2 rev/s) its force integral does not learn while the
+// rotor cannot follow its speed reference, so the release to 3 kN stops at the pads: no actuator
+// finding and the brake never off while 2 kN or more is commanded. With the shipped default
+// (learning regardless; tuning seed 1408 run 94) the release runs 1.9 rev past the pads and the
+// CCU names the healthy actuator actuator_tracking: a known, open defect (docs/plant.md).
+TEST(ClosedLoopIssue14, AReleaseOnTheCurveAfterALoadCellFindingStopsAtThePadsWithTheIntegralOption) {
   auto fs = load("config/scenarios/faults/load_cell_bias_in_hard_stop_then_release_on_the_curve.yaml");
   const auto fr = [](const LoopResult& r) { return actuator(r, 1); };
   const auto off_s = [](const LoopResult& r) {
@@ -605,14 +606,15 @@ TEST(ClosedLoopIssue14, AReleaseOnTheCurveAfterALoadCellFindingStopsAtThePads) {
     }
     return s;
   };
+  // The shipped default (0: off) winds up; the option on (2 rev/s) does not.
+  const auto wound = run_closed_loop(fs, default_options());
+  fs.scenario.controller.force_integral_max_speed_error_rev_per_s = 2.0;
   const auto r = run_closed_loop(fs, default_options());
   ASSERT_EQ(r.outcomes.size(), 1u);
   EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct);
   EXPECT_FALSE(fr(r).present) << to_string(fr(r).finding) << " at " << fr(r).detected_s;
   EXPECT_EQ(r.faults_raised(), 1u);
   EXPECT_LT(off_s(r), 0.02);
-  fs.scenario.controller.force_integral_max_speed_error_rev_per_s = 0.0;
-  const auto wound = run_closed_loop(fs, default_options());
   EXPECT_GT(off_s(wound), 0.1);
   ASSERT_TRUE(fr(wound).present);
   std::printf("brake off while >= 2 kN commanded: %.0f ms; with the integral learning regardless %.0f ms and %s at %.3f s\n",

@@ -32,12 +32,14 @@ struct ControllerParams {
   double max_speed_rev_per_s = 25.0;
   double force_bandwidth_rad_per_s = 30.0;
   double force_integral_rad_per_s2 = 150.0;
-  // The force integral learns only while the speed loop follows its reference within this (a
-  // steady error the loop can act on): while the rotor cannot follow (a drive backing off a hold
-  // against its load and friction at 0.2-0.8 rev/s for a reference of -7 rev/s) it wound up to
-  // 10 kN's worth, and a later fast release ran 1.9 rev past its command and left the brake off
-  // for 0.25 s (issue 14, tuning seed 1408 run 94). 0: off (integrate whenever not clipped).
-  double force_integral_max_speed_error_rev_per_s = 2.0;
+  // If > 0, the force integral learns only while the speed loop follows its reference within
+  // this (a steady error the loop can act on): while the rotor cannot follow (a drive backing off
+  // a hold against its load and friction at 0.2-0.8 rev/s for a reference of -7 rev/s) it wound
+  // up to 10 kN's worth, and a later fast release ran 1.9 rev past its command and left the brake
+  // off for 0.21 s (issue 14, tuning seed 1408 run 94; 2 rev/s fixes it). Off by default (0:
+  // integrate whenever not clipped): it also changes how a drive that lost two thirds of its
+  // torque holds, which the monitor then named lost in a hold (docs/plant.md).
+  double force_integral_max_speed_error_rev_per_s = 0.0;
   double stiffness_at_zero_kN_per_rev = 2.5;
   double stiffness_per_kN_per_rev = 0.3;       // (kN/rev) per kN
   double release_force_kN = 0.1;
