@@ -73,10 +73,11 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
     need_lo_Nm_ += (lo - need_lo_Nm_) * k;
   }
   // Lost: against the drive as it now is (after a named torque loss, its remaining torque). For
-  // this rule and the torque loss's (below), a load not measured (the load cell diagnosed: the force estimate is a curve, up to 24 % off
-  // an uncalibrated caliper's) is taken at the top of its plausible range: a drive decelerated
-  // against more load than the estimate says looked as if its torque went nowhere (tuning seed
-  // 1403 run 502: estimate 8.4 kN, true 11.0 kN and 2.0 kN of key friction; lost at 20.9 s).
+  // this rule and the torque loss's (below), a load not measured (the load cell diagnosed: the
+  // force estimate is a curve, up to a quarter off an uncalibrated caliper's) is taken at the top
+  // of its plausible range: a drive decelerated against more load than the estimate says looked
+  // as if its torque went nowhere (tuning seed 1403 run 502: estimate 8.4 kN, true 11.0 kN and
+  // 2.0 kN of key friction; lost at 20.9 s).
   const double judged_fraction =
       !checkable || load_cell_load || !p.torque_lost_unmeasured_load_high ? fraction : std::max(fraction, need_hi_Nm_ / make_Nm_);
   if (checkable && judged_fraction / motor_scale_ < p.torque_lost_threshold) {
@@ -94,7 +95,6 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // load is the load cell's and, with an end-of-line curve, also the curve's (above): pushing,
   // the larger of the two must not explain the torque; pulling, the smaller (a load-cell fault
   // moves only one of them).
-  // (the load's range, need_hi_Nm_ and need_lo_Nm_, above)
   const double load_Nm = std::max(std::abs(load_hi_kN), std::abs(load_lo_kN)) * p.Nm_per_kN;
   const double band = p.drive.coulomb_friction_Nm + p.unexplained_margin_Nm + p.unexplained_relative * load_Nm;
   excess_Nm_ = make_Nm_ - need_hi_Nm_;

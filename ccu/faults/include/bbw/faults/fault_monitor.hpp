@@ -234,8 +234,9 @@ struct MonitorParams {
   bool torque_loss_rescales_drive = true;
   // A load not measured (the load cell diagnosed: the force estimate is a curve) is taken at
   // the top of its plausible range (the end-of-line curve's with the key friction's width and
-  // the curve's band) by the lost rule (fourteenth session: a healthy drive decelerated against
-  // more load than an uncalibrated curve says looked as if its torque went nowhere).
+  // the curve's band) by the lost and torque-loss rules (fourteenth session: a healthy drive
+  // decelerated against more load than an uncalibrated curve says looked as if its torque went
+  // nowhere).
   bool torque_lost_unmeasured_load_high = true;
   // Unexplained torque (issue 14: a seized drive or a motor that makes no torque, at any load):
   // near standstill, the measured current's torque against what the load, the acceleration and
