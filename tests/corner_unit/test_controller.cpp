@@ -241,4 +241,3 @@ TEST(ForceMode, AFrozenResolverDrivesNoCurrentUntilItLivesAgain) {
   const auto [off_max_kN, off_A, off_end_kN] = run(0);  // the rule off: the speed loop winds up
   EXPECT_GT(off_max_kN, 25.0) << off_A << " " << off_end_kN;  // 33 kN against a 20 kN command
 }
-

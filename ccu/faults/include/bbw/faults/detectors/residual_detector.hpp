@@ -47,8 +47,7 @@ class ResidualDetector {
     hold_ref_ = false;
     hold_slow_ = 0;
     hold_sum_kN_ = 0.0;
-    friction_known_ = false;  // the positions in the gap are unknown: so is the friction's state
-    have_x_ = false;
+    forget_position();  // the positions in the gap are unknown: so is the friction's state
   }
   // Whether the end-of-line friction model's state is known (the position has swept twice its
   // largest threshold since the start or the last gap), and its friction (kN).
