@@ -569,6 +569,51 @@ TEST(ClosedLoopIssue14, AfterALoadCellFindingAHealthyDriveOnAnUncalibratedCurveI
               to_string(rr(base).finding), rr(base).detected_s);
 }
 
+// A load-cell drift in a held hard stop that the corner's loop follows by creeping back: the hold
+// rule keeps its reference for hold_span_known_rev (0.3 rev) once the end-of-line friction model's
+// state is known, and names the drift within its window (tuning seed 1408 run 466). Kept only
+// within 0.1 rev (the span before the fifteenth session), the creep restarted the hold and threw
+// away what the drift had moved: named after the release, past the window.
+TEST(ClosedLoopIssue14, ADriftTheLoopFollowsInAHardStopIsNamedWithinItsWindow) {
+  const auto fs = load("config/scenarios/faults/load_cell_drift_the_loop_follows_in_a_hard_stop.yaml");
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << to_string(r.outcomes[0].diagnosis);
+  EXPECT_EQ(r.faults_raised(), 1u);
+  auto opts = default_options();
+  opts.monitor.hold_span_known_rev = opts.monitor.hold_span_rev;
+  const auto base = run_closed_loop(fs, opts);
+  ASSERT_EQ(base.outcomes.size(), 1u);
+  EXPECT_FALSE(base.outcomes[0].detected);
+  std::printf("hold span 0.3 rev once the friction is known: named after %.0f ms; 0.1 rev: %s after %.0f ms (window %.0f ms)\n",
+              r.outcomes[0].latency_ms, to_string(base.outcomes[0].diagnosis), base.outcomes[0].diagnosis_latency_ms,
+              1e3 * detection_window_s(fs.faults.faults[0]));
+}
+
+// A load-cell drift while the brake modulates (ABS-like) on a calibrated corner: the thresholds
+// learnt from the corner's own residual followed it (1.9 -> 8.7 kN in 3.4 s) and it was never
+// named while the loop drove the healthy actuator back past its stroke (tuning seed 1408 run 145).
+// Capped at the end-of-line band the fit replaced, the thresholds let it be named within 2 s;
+// uncapped, not before the modulation ends (8 s).
+TEST(ClosedLoopIssue14, ADriftWhileTheBrakeModulatesCannotWidenTheThresholdsBeyondTheEndOfLineBand) {
+  const auto fs = load("config/scenarios/faults/load_cell_drift_while_the_brake_modulates.yaml");
+  const double at_s = fs.faults.faults.at(0).at_s;
+  const auto named_s = [](const LoopResult& r) {
+    const auto& d = r.diagnoses[2 * 5 + static_cast<std::size_t>(Part::LoadCell)];  // RL
+    return d.present && d.finding == Finding::LoadCellOffset ? d.detected_s : std::numeric_limits<double>::infinity();
+  };
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  EXPECT_LT(named_s(r), at_s + 2.0);
+  EXPECT_EQ(r.faults_raised(), 1u);
+  auto opts = default_options();
+  opts.monitor.calibrated_capped_by_eol = false;
+  const auto base = run_closed_loop(fs, opts);
+  EXPECT_GT(named_s(base), 8.0);
+  std::printf("capped: named %.3f s after the drift began; uncapped: %.3f s (window %.3f s)\n", named_s(r) - at_s,
+              named_s(base) - at_s, detection_window_s(fs.faults.faults[0]));
+}
+
 // The end-of-line friction model follows the position while the load cell gives no value: the
 // dropout's finding clears when the load cell is back and nothing else is raised (tuning seed
 // 1401 run 244: a false load_cell_offset 20 ms after it cleared, the model left where the

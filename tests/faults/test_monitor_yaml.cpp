@@ -63,6 +63,18 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(test_pulse_healthy_ratio); SAME(test_pulse_learn_count);
   SAME(tracking_time_constant_s); SAME(tracking_threshold_kN); SAME(tracking_relative); SAME(tracking_persist_s);
   SAME(force_limit_kN); SAME(release_min_speed_rev_per_s); SAME(deadline_s);
+  SAME(residual_stats_clip); SAME(eol_friction_model_share); SAME(calibrated_two_friction_models); SAME(calibrated_capped_by_eol);
+  SAME(hold_kN); SAME(hold_speed_rev_per_s); SAME(hold_span_rev); SAME(hold_span_known_rev); SAME(hold_settle_samples);
+  SAME(hold_calibrated); SAME(hold_rebase);
+  SAME(stuck_frozen_samples); SAME(stuck_frozen_run_factor); SAME(stuck_resolver_clear_samples);
+  SAME(step_still_samples); SAME(step_still_span_rev); SAME(step_min_position_changes); SAME(step_kN); SAME(step_keep_fraction);
+  SAME(step_confirm_samples); SAME(step_moving); SAME(step_moving_window_samples); SAME(step_moving_quiet_fraction);
+  SAME(step_moving_unexplained_rev); SAME(step_moving_speed_kN_per_rev_per_s);
+  SAME(noise_second_difference_kN); SAME(noise_learned_factor); SAME(noise_learn_time_constant_s);
+  SAME(unexplained_margin_Nm); SAME(unexplained_relative); SAME(unexplained_max_speed_rev_per_s); SAME(unexplained_persist_s);
+  SAME(seized_static_rev); SAME(seized_window_s); SAME(seized_ramp_Nm); SAME(seized_force_error_kN);
+  // Not in the file: the corner's end-of-line key-friction half-width and backlash (CcuCore sets
+  // them from the scenario), the actuator test's current and length (the scenario's controller).
 #undef SAME
 }
 

@@ -38,6 +38,7 @@ void MonitorParams::validate() const {
   positive("hold_kN", hold_kN);
   positive("hold_speed_rev_per_s", hold_speed_rev_per_s);
   positive("hold_span_rev", hold_span_rev);
+  positive("hold_span_known_rev", hold_span_known_rev);
   require(hold_settle_samples >= 1, "hold_settle_samples", hold_settle_samples, "must be >= 1");
   require(std::isfinite(eol_backlash_rev) && eol_backlash_rev >= 0.0, "eol_backlash_rev", eol_backlash_rev, "must be >= 0");
   require(std::isfinite(eol_friction_model_share) && eol_friction_model_share >= 0.0 && eol_friction_model_share <= 1.0,

@@ -41,6 +41,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.eol_friction_amplitude_factor = eol.number("friction_amplitude_factor", config::Range::at_least(1.0));
     p.eol_friction_model_share = eol.number("friction_model_share", config::Range::closed(0.0, 1.0));
     p.calibrated_two_friction_models = eol.boolean("calibrated_two_friction_models");
+    p.calibrated_capped_by_eol = eol.boolean("calibrated_capped");
     eol.finish();
   }
   {
@@ -48,6 +49,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.hold_kN = h.number("kN", pos);
     p.hold_speed_rev_per_s = h.number("speed_rev_per_s", pos);
     p.hold_span_rev = h.number("span_rev", pos);
+    p.hold_span_known_rev = h.number("span_known_rev", pos);
     p.hold_settle_samples = static_cast<int>(h.integer("settle_samples", 1, 100000));
     p.hold_calibrated = h.boolean("calibrated");
     p.hold_rebase = h.boolean("rebase");

@@ -147,6 +147,14 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     // Beyond the speeds a force loop corrects at (its reaction to a step must stay visible).
     const double speed_kN = p.residual_speed_kN_per_rev_per_s * std::max(0.0, std::abs(r.speed_rev_per_s) - p.residual_speed_free_rev_per_s);
     thr += speed_kN;
+    if (eol_ && friction_known_ && p.calibrated_two_friction_models && p.calibrated_capped_by_eol) {
+      // The residual nearest zero of the two friction models is never farther from zero than the
+      // end-of-line one: this cap makes the calibrated rule no less sensitive than the
+      // end-of-line band it replaced, however far the learnt statistics have grown.
+      const double eol_thr = p.eol_friction_model_share * p.eol_friction_half_width_kN + p.eol_band_kN +
+                             p.eol_relative * std::abs(eol_keys_kN) + p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s);
+      thr = std::max(p.residual_threshold_kN, std::min(thr, eol_thr));
+    }
     // (The change rule's speed allowance is added below, against the reference's speed.)
     if (eol_mode_) have_reference_ = false;
     eol_mode_ = false;
@@ -214,13 +222,15 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     redefined = false;
   }
   hold_refit_ = false;
-  if (!slow || redefined || (hold_ref_ && std::abs(x_hold - hold_x0_rev_) > p.hold_span_rev)) {
+  const double span_rev = hold_known_ && friction_known_ ? p.hold_span_known_rev : p.hold_span_rev;
+  if (!slow || redefined || (hold_ref_ && std::abs(x_hold - hold_x0_rev_) > span_rev)) {
     hold_ref_ = false;
     hold_slow_ = 0;
     hold_sum_kN_ = 0.0;
   }
   bool hold_over = false;
   hold_change_kN_ = std::numeric_limits<double>::quiet_NaN();
+  hold_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
   if (slow && !hold_ref_) {
     if (hold_slow_ == 0) {  // the definition the reference is averaged under
       hold_eol_mode_ = eol_here;
@@ -239,6 +249,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     const double hold_thr = p.hold_kN + p.eol_relative * std::abs(hold_curve_kN - hold_f0_kN_) +
                             p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s) +
                             (friction_known_ ? p.eol_friction_model_share : 1.0) * p.eol_friction_half_width_kN;
+    hold_threshold_kN_ = hold_thr;
     hold_over = std::abs(hold_change_kN_) > hold_thr;
   }
   hold_last_kN_ = slow ? residual_kN_ : std::numeric_limits<double>::quiet_NaN();

@@ -87,6 +87,12 @@ struct MonitorParams {
   // the two friction models' (the calibrator's, the end-of-line one) nearest zero, 0 when they
   // bracket it (a load-cell fault moves the load cell against both).
   bool calibrated_two_friction_models = true;
+  // Calibrated, once that state is known: the thresholds learnt from the corner's own residual
+  // never exceed the end-of-line band (friction model share, band, relative, speed). A fit can
+  // only make the monitor know the caliper better than its end-of-line data, and the learnt
+  // statistics could follow a slow drift while the brake modulates (tune_bias run 145: a
+  // 1.2 kN/s drift in ABS braking, threshold 1.9 -> 8.7 kN in 3.4 s, never named).
+  bool calibrated_capped_by_eol = true;
   // The caliper's backlash between the motor (the resolver) and the spindle (the keys, the
   // pads), as its end-of-line test measured it (CcuCore sets the corner's; 0: none).
   double eol_backlash_rev = 0.0;
@@ -97,6 +103,10 @@ struct MonitorParams {
   double hold_kN = 0.5;
   double hold_speed_rev_per_s = 0.5;
   double hold_span_rev = 0.1;
+  // ... or within hold_span_known_rev once the end-of-line friction model's state is known (and
+  // was when the hold settled): the model follows the keys' friction through any travel, within
+  // its share; the span then only bounds how far the curve's relative accuracy is trusted.
+  double hold_span_known_rev = 0.3;
   int hold_settle_samples = 20;
   // The hold rule on calibrated corners too (with an end-of-line curve): the learnt residual
   // statistics follow a slow drift the loop absorbs by creeping; the hold's level does not.
@@ -359,6 +369,9 @@ class FaultMonitor {
   // The thresholds the last residual and its change were held against (NaN where none applied).
   double last_residual_threshold_kN() const { return residual_.threshold_kN(); }
   double last_residual_change_threshold_kN() const { return residual_.change_threshold_kN(); }
+  // The hold rule's change since its hold settled and its allowance (kN; NaN outside a hold).
+  double last_hold_change_kN() const { return residual_.hold_change_kN(); }
+  double last_hold_threshold_kN() const { return residual_.hold_threshold_kN(); }
   // A residual disagreement is under way but not yet confirmed: the calibrator must not learn
   // from these samples (CornerSupervisor holds its fits).
   bool residual_suspect() const { return residual_.suspect(); }

@@ -76,6 +76,8 @@ class ResidualDetector {
   double change_kN() const { return change_kN_; }
   // The residual's change since the hold settled (NaN outside a hold).
   double hold_change_kN() const { return hold_change_kN_; }
+  // The allowance that change was held against (kN; NaN outside a hold).
+  double hold_threshold_kN() const { return hold_threshold_kN_; }
 
  private:
   bool suspect_ = false;
@@ -122,6 +124,7 @@ class ResidualDetector {
   double hold_x0_rev_ = 0.0;
   double hold_f0_kN_ = 0.0;
   double hold_change_kN_ = std::numeric_limits<double>::quiet_NaN();
+  double hold_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
   bool hold_refit_ = false;  // a fit was accepted since the last sample
   // The last sample's residual (NaN when it was not slow), key position and curve, for a rebase.
   double hold_last_kN_ = std::numeric_limits<double>::quiet_NaN();
