@@ -55,6 +55,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.hold_rebase = h.boolean("rebase");
     h.finish();
   }
+  p.residual_low_upper_bound = res.boolean("low_upper_bound");
   p.curve_min_rev = res.number("curve_min_rev");
   p.curve_max_rev = res.number("curve_max_rev");
   p.residual_on_profile_corners = res.boolean("on_profile_corners");

@@ -80,6 +80,26 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   const bool fitted_here = eol_ ? e.calibrated && fit_credible_ && above_min
                                 : r.position_rev >= curve_min_rev_ && r.position_rev <= curve_max_rev_;
   const bool eol_here = !fitted_here && eol_ && above_min;
+  if (!fitted_here && !eol_here && eol_ && !above_min && p.residual_low_upper_bound && p.residual_findings &&
+      std::isfinite(r.force_kN)) {
+    // Below the trusted range the key friction snaps across its width with small motions and the
+    // contact point moves with wear: only an upper bound holds. The curve where the keys can be
+    // furthest in (the motor's position plus half the play), at least 0.
+    const double f_hi_kN = std::max(0.0, eol_->force_kN(r.position_rev + 0.5 * p.eol_backlash_rev, temperature_C, 0.0));
+    const double low_thr = p.eol_friction_half_width_kN + p.eol_band_kN + p.eol_relative * f_hi_kN +
+                           p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s);
+    if (r.force_kN - f_hi_kN > low_thr) {
+      if (!low_suspect_) {
+        low_suspect_ = true;
+        low_onset_s_ = t;
+      }
+      if (t - low_onset_s_ >= p.residual_persist_s) isolate(low_onset_s_, t, p, a, stuck, jump);
+    } else {
+      low_suspect_ = false;
+    }
+  } else {
+    low_suspect_ = false;
+  }
   if (!fitted_here && !eol_here) {
     suspect_ = false;  // no trusted curve here
     residual_kN_ = std::numeric_limits<double>::quiet_NaN();
@@ -297,6 +317,11 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     onset_s_ = t;
   }
   if (t - onset_s_ < p.residual_persist_s) return;
+  isolate(onset_s_, t, p, a, stuck, jump);
+}
+
+void ResidualDetector::isolate(double onset_s, double t, const MonitorParams& p, DiagnosisArbiter& a,
+                               const StuckDetector& stuck, const JumpDetector& jump) const {
   // Isolation: which channel explains the disagreement?
   const bool position_frozen = stuck.position_repeats() >= p.frozen_attribution_samples;
   const bool load_cell_frozen = stuck.load_cell_repeats() >= p.frozen_attribution_samples;
@@ -308,7 +333,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   } else if (t - jump.last_jump_s() <= p.jump_window_s + p.residual_persist_s) {
     f = Finding::ResolverOffset;
   }
-  a.confirm(f, onset_s_, t);
+  a.confirm(f, onset_s, t);
 }
 
 }  // namespace bbw::faults

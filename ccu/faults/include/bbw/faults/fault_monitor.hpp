@@ -134,6 +134,13 @@ struct MonitorParams {
   // is still computed (and feeds the noise detector) when this is false. CcuCore applies it.
   bool residual_on_profile_corners = false;
   bool residual_findings = true;  // set per corner by CcuCore from the rule above
+  // Below the trusted range, with an end-of-line curve: a load cell that reads more than the
+  // curve at the position (plus half the drive's play, at least 0) + the key friction's
+  // half-width + eol_band_kN + eol_relative x that force + the speed term names a load-cell
+  // offset. One-sided: wear moves the contact point later, so the curve bounds the force from
+  // above only. A positive drift the loop follows by releasing drives the pads below the trusted
+  // range, where the two-sided rules do not look (tune_bias run 73).
+  bool residual_low_upper_bound = true;
 
   // Resolver consistency: a position step the measured speed does not explain.
   double jump_threshold_rev = 0.01;

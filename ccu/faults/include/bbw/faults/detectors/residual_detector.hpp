@@ -44,6 +44,7 @@ class ResidualDetector {
               NoiseDetector& noise, const StuckDetector& stuck, const JumpDetector& jump);
   void on_rejoin() {
     suspect_ = false;
+    low_suspect_ = false;
     hold_ref_ = false;
     hold_slow_ = 0;
     hold_sum_kN_ = 0.0;
@@ -81,6 +82,12 @@ class ResidualDetector {
 
  private:
   bool suspect_ = false;
+  // The rule below the trusted range (residual_low_upper_bound): its own persistence.
+  bool low_suspect_ = false;
+  double low_onset_s_ = 0.0;
+  // Names the channel that explains a disagreement that began at onset_s and confirms it.
+  void isolate(double onset_s, double t, const MonitorParams& p, DiagnosisArbiter& a, const StuckDetector& stuck,
+               const JumpDetector& jump) const;
   bool fit_credible_ = true;
   double onset_s_ = 0.0;
   double residual_kN_ = std::numeric_limits<double>::quiet_NaN();
