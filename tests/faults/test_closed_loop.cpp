@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 
 #include "closed_loop.hpp"
@@ -569,25 +570,39 @@ TEST(ClosedLoopIssue14, AfterALoadCellFindingAHealthyDriveOnAnUncalibratedCurveI
               to_string(rr(base).finding), rr(base).detected_s);
 }
 
+namespace {
+
+// Runs a one-fault scenario with the shipped monitor and again with `without` applied to it: the
+// first names the fault rightly within its window and raises nothing else, the second does not
+// name it within its window. Prints both latencies.
+void expect_named_in_window_only_with_the_rule(const std::string& file, const char* rule,
+                                               const std::function<void(MonitorParams&)>& without) {
+  const auto fs = load(file);
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << to_string(r.outcomes[0].diagnosis);
+  EXPECT_EQ(r.faults_raised(), 1u);
+  auto opts = default_options();
+  without(opts.monitor);
+  const auto base = run_closed_loop(fs, opts);
+  ASSERT_EQ(base.outcomes.size(), 1u);
+  EXPECT_FALSE(base.outcomes[0].detected);
+  std::printf("with %s: named after %.0f ms; without: %s after %.0f ms (window %.0f ms)\n", rule, r.outcomes[0].latency_ms,
+              to_string(base.outcomes[0].diagnosis), base.outcomes[0].diagnosis_latency_ms,
+              1e3 * detection_window_s(fs.faults.faults[0]));
+}
+
+}  // namespace
+
 // A load-cell drift in a held hard stop that the corner's loop follows by creeping back: the hold
 // rule keeps its reference for hold_span_known_rev (0.3 rev) once the end-of-line friction model's
 // state is known, and names the drift within its window (tuning seed 1408 run 466). Kept only
 // within 0.1 rev (the span before the fifteenth session), the creep restarted the hold and threw
 // away what the drift had moved: named after the release, past the window.
 TEST(ClosedLoopIssue14, ADriftTheLoopFollowsInAHardStopIsNamedWithinItsWindow) {
-  const auto fs = load("config/scenarios/faults/load_cell_drift_the_loop_follows_in_a_hard_stop.yaml");
-  const auto r = run_closed_loop(fs, default_options());
-  ASSERT_EQ(r.outcomes.size(), 1u);
-  EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << to_string(r.outcomes[0].diagnosis);
-  EXPECT_EQ(r.faults_raised(), 1u);
-  auto opts = default_options();
-  opts.monitor.hold_span_known_rev = opts.monitor.hold_span_rev;
-  const auto base = run_closed_loop(fs, opts);
-  ASSERT_EQ(base.outcomes.size(), 1u);
-  EXPECT_FALSE(base.outcomes[0].detected);
-  std::printf("hold span 0.3 rev once the friction is known: named after %.0f ms; 0.1 rev: %s after %.0f ms (window %.0f ms)\n",
-              r.outcomes[0].latency_ms, to_string(base.outcomes[0].diagnosis), base.outcomes[0].diagnosis_latency_ms,
-              1e3 * detection_window_s(fs.faults.faults[0]));
+  expect_named_in_window_only_with_the_rule("config/scenarios/faults/load_cell_drift_the_loop_follows_in_a_hard_stop.yaml",
+                                            "the 0.3 rev hold span once the friction is known",
+                                            [](MonitorParams& m) { m.hold_span_known_rev = m.hold_span_rev; });
 }
 
 // A load-cell drift while the brake modulates (ABS-like) on a calibrated corner: the thresholds
@@ -620,18 +635,9 @@ TEST(ClosedLoopIssue14, ADriftWhileTheBrakeModulatesCannotWidenTheThresholdsBeyo
 // 364: never named). The end-of-line curve bounds the force from above (residual.low_upper_bound):
 // named within the drift's window; without the bound, not within it.
 TEST(ClosedLoopIssue14, ADriftBelowTheTrustedRangeIsNamedByTheCurvesUpperBound) {
-  const auto fs = load("config/scenarios/faults/load_cell_drift_below_the_trusted_range.yaml");
-  const auto r = run_closed_loop(fs, default_options());
-  ASSERT_EQ(r.outcomes.size(), 1u);
-  EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << to_string(r.outcomes[0].diagnosis);
-  EXPECT_EQ(r.faults_raised(), 1u);
-  auto opts = default_options();
-  opts.monitor.residual_low_upper_bound = false;
-  const auto base = run_closed_loop(fs, opts);
-  ASSERT_EQ(base.outcomes.size(), 1u);
-  EXPECT_FALSE(base.outcomes[0].detected);
-  std::printf("with the upper bound: named after %.0f ms; without: %s (window %.0f ms)\n", r.outcomes[0].latency_ms,
-              to_string(base.outcomes[0].diagnosis), 1e3 * detection_window_s(fs.faults.faults[0]));
+  expect_named_in_window_only_with_the_rule("config/scenarios/faults/load_cell_drift_below_the_trusted_range.yaml",
+                                            "the curve's upper bound below the trusted range",
+                                            [](MonitorParams& m) { m.residual_low_upper_bound = false; });
 }
 
 // The end-of-line friction model follows the position while the load cell gives no value: the

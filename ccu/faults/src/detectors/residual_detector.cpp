@@ -8,6 +8,16 @@
 
 namespace bbw::faults {
 
+namespace {
+
+// An end-of-line allowance: a base (the band, or the hold's), the key friction's share, the
+// end-of-line measurement's relative accuracy at a force and the unmodelled speed effects.
+double eol_allowance_kN(const MonitorParams& p, double base_kN, double friction_kN, double force_kN, double speed_rev_per_s) {
+  return base_kN + friction_kN + p.eol_relative * std::abs(force_kN) + p.eol_speed_kN_per_rev_per_s * std::abs(speed_rev_per_s);
+}
+
+}  // namespace
+
 ResidualDetector::ResidualDetector(const MonitorParams& p)
     : curve_min_rev_(p.curve_min_rev), curve_max_rev_(p.curve_max_rev), trusted_min_rev_(p.curve_min_rev) {
   if (p.residual_stats_clip > 0.0) {
@@ -86,8 +96,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     // contact point moves with wear: only an upper bound holds. The curve where the keys can be
     // furthest in (the motor's position plus half the play), at least 0.
     const double f_hi_kN = std::max(0.0, eol_->force_kN(r.position_rev + 0.5 * p.eol_backlash_rev, temperature_C, 0.0));
-    const double low_thr = p.eol_friction_half_width_kN + p.eol_band_kN + p.eol_relative * f_hi_kN +
-                           p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s);
+    const double low_thr = eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_half_width_kN, f_hi_kN, r.speed_rev_per_s);
     if (r.force_kN - f_hi_kN > low_thr) {
       if (!low_suspect_) {
         low_suspect_ = true;
@@ -121,8 +130,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       residual_kN_ -= eol_friction_kN_;
       friction_band_kN *= p.eol_friction_model_share;
     }
-    thr = friction_band_kN + p.eol_band_kN + p.eol_relative * std::abs(eol_kN) +
-          p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s);
+    thr = eol_allowance_kN(p, p.eol_band_kN, friction_band_kN, eol_kN, r.speed_rev_per_s);
     if (!eol_mode_) have_reference_ = false;
     eol_mode_ = true;
   } else if (!e.calibrated) {
@@ -171,8 +179,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       // The residual nearest zero of the two friction models is never farther from zero than the
       // end-of-line one: this cap makes the calibrated rule no less sensitive than the
       // end-of-line band it replaced, however far the learnt statistics have grown.
-      const double eol_thr = p.eol_friction_model_share * p.eol_friction_half_width_kN + p.eol_band_kN +
-                             p.eol_relative * std::abs(eol_keys_kN) + p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s);
+      const double eol_thr = eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_model_share * p.eol_friction_half_width_kN,
+                                              eol_keys_kN, r.speed_rev_per_s);
       thr = std::max(p.residual_threshold_kN, std::min(thr, eol_thr));
     }
     // (The change rule's speed allowance is added below, against the reference's speed.)
@@ -266,9 +274,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     }
   } else if (hold_ref_) {
     hold_change_kN_ = residual_kN_ - hold_r0_kN_;
-    const double hold_thr = p.hold_kN + p.eol_relative * std::abs(hold_curve_kN - hold_f0_kN_) +
-                            p.eol_speed_kN_per_rev_per_s * std::abs(r.speed_rev_per_s) +
-                            (friction_known_ ? p.eol_friction_model_share : 1.0) * p.eol_friction_half_width_kN;
+    const double hold_thr = eol_allowance_kN(p, p.hold_kN, (friction_known_ ? p.eol_friction_model_share : 1.0) * p.eol_friction_half_width_kN,
+                                             hold_curve_kN - hold_f0_kN_, r.speed_rev_per_s);
     hold_threshold_kN_ = hold_thr;
     hold_over = std::abs(hold_change_kN_) > hold_thr;
   }
