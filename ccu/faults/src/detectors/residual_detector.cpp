@@ -90,24 +90,23 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   const bool fitted_here = eol_ ? e.calibrated && fit_credible_ && above_min
                                 : r.position_rev >= curve_min_rev_ && r.position_rev <= curve_max_rev_;
   const bool eol_here = !fitted_here && eol_ && above_min;
-  if (!fitted_here && !eol_here && eol_ && !above_min && p.residual_low_upper_bound && p.residual_findings &&
-      std::isfinite(r.force_kN)) {
-    // Below the trusted range the key friction snaps across its width with small motions and the
-    // contact point moves with wear: only an upper bound holds. The curve where the keys can be
-    // furthest in (the motor's position plus half the play), at least 0.
+  // Below the trusted range (where, with an end-of-line curve, neither residual above applies) the
+  // key friction snaps across its width with small motions and the contact point moves with wear:
+  // only an upper bound holds, the curve where the keys can be furthest in (the motor's position
+  // plus half the play), at least 0.
+  bool low_over = false;
+  if (eol_ && !above_min && p.residual_low_upper_bound && p.residual_findings && std::isfinite(r.force_kN)) {
     const double f_hi_kN = std::max(0.0, eol_->force_kN(r.position_rev + 0.5 * p.eol_backlash_rev, temperature_C, 0.0));
-    const double low_thr = eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_half_width_kN, f_hi_kN, r.speed_rev_per_s);
-    if (r.force_kN - f_hi_kN > low_thr) {
-      if (!low_suspect_) {
-        low_suspect_ = true;
-        low_onset_s_ = t;
-      }
-      if (t - low_onset_s_ >= p.residual_persist_s) isolate(low_onset_s_, t, p, a, stuck, jump);
-    } else {
-      low_suspect_ = false;
-    }
-  } else {
+    low_over = r.force_kN - f_hi_kN > eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_half_width_kN, f_hi_kN, r.speed_rev_per_s);
+  }
+  if (!low_over) {
     low_suspect_ = false;
+  } else {
+    if (!low_suspect_) {
+      low_suspect_ = true;
+      low_onset_s_ = t;
+    }
+    if (t - low_onset_s_ >= p.residual_persist_s) isolate(low_onset_s_, t, p, a, stuck, jump);
   }
   if (!fitted_here && !eol_here) {
     suspect_ = false;  // no trusted curve here
@@ -250,7 +249,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     redefined = false;
   }
   hold_refit_ = false;
-  const double span_rev = hold_known_ && friction_known_ ? p.hold_span_known_rev : p.hold_span_rev;
+  // (Within a hold the friction model's state cannot change without restarting or rebasing it.)
+  const double span_rev = friction_known_ ? p.hold_span_known_rev : p.hold_span_rev;
   if (!slow || redefined || (hold_ref_ && std::abs(x_hold - hold_x0_rev_) > span_rev)) {
     hold_ref_ = false;
     hold_slow_ = 0;
