@@ -572,17 +572,20 @@ TEST(ClosedLoopIssue14, AfterALoadCellFindingAHealthyDriveOnAnUncalibratedCurveI
 
 namespace {
 
-// Runs a one-fault scenario with the shipped monitor and again with `without` applied to it: the
-// first names the fault rightly within its window and raises nothing else, the second does not
-// name it within its window. Prints both latencies.
+// Runs a one-fault scenario with the shipped monitor (with `common` applied to it) and again with
+// `without` applied too: the first names the fault rightly within its window and raises nothing
+// else, the second does not name it within its window. Prints both latencies.
 void expect_named_in_window_only_with_the_rule(const std::string& file, const char* rule,
-                                               const std::function<void(MonitorParams&)>& without) {
+                                               const std::function<void(MonitorParams&)>& without,
+                                               const std::function<void(MonitorParams&)>& common = [](MonitorParams&) {}) {
   const auto fs = load(file);
-  const auto r = run_closed_loop(fs, default_options());
+  auto shipped = default_options();
+  common(shipped.monitor);
+  const auto r = run_closed_loop(fs, shipped);
   ASSERT_EQ(r.outcomes.size(), 1u);
   EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << to_string(r.outcomes[0].diagnosis);
   EXPECT_EQ(r.faults_raised(), 1u);
-  auto opts = default_options();
+  auto opts = shipped;
   without(opts.monitor);
   const auto base = run_closed_loop(fs, opts);
   ASSERT_EQ(base.outcomes.size(), 1u);
@@ -598,11 +601,14 @@ void expect_named_in_window_only_with_the_rule(const std::string& file, const ch
 // rule keeps its reference for hold_span_known_rev (0.3 rev) once the end-of-line friction model's
 // state is known, and names the drift within its window (tuning seed 1408 run 466). Kept only
 // within 0.1 rev (the span before the fifteenth session), the creep restarted the hold and threw
-// away what the drift had moved: named after the release, past the window.
+// away what the drift had moved: named after the release, past the window. With an end-of-line
+// test accurate to 3 % (as shipped until the sixteenth session): since the shipped 1 % the
+// end-of-line band alone names this drift within its window (1271 of 1630 ms).
 TEST(ClosedLoopIssue14, ADriftTheLoopFollowsInAHardStopIsNamedWithinItsWindow) {
   expect_named_in_window_only_with_the_rule("config/scenarios/faults/load_cell_drift_the_loop_follows_in_a_hard_stop.yaml",
                                             "the 0.3 rev hold span once the friction is known",
-                                            [](MonitorParams& m) { m.hold_span_known_rev = m.hold_span_rev; });
+                                            [](MonitorParams& m) { m.hold_span_known_rev = m.hold_span_rev; },
+                                            [](MonitorParams& m) { m.eol_relative = 0.03; });
 }
 
 // A load-cell drift while the brake modulates (ABS-like) on a calibrated corner: the thresholds
