@@ -1005,6 +1005,53 @@ TEST(FaultMonitor, BeforeAFitTheEndOfLineFrictionModelAndTheHoldRuleFindADrift) 
   EXPECT_LT(d.detected_s, 4.5);
 }
 
+// After a resolver offset is named the resolver still measures the motion: less the offset its
+// confirmed jump measured, the position the residual rules need (resolver_jump.compensate). The
+// monitor gets no calibrator estimate once a sensor is diagnosed (as from CornerSupervisor): the
+// end-of-line curve and band judge the load cell. An intermittent offset (+0.08 rev from 2 s,
+// gone at 4 s) on a caliper that modulates +/- 0.3 rev: nothing but the resolver is named; a
+// 1 kN/s load-cell drift from 2.5 s (while the offset lasts) or from 4.5 s (after it) is named
+// within its window (1 kN / rate + 0.5 s); with the compensation off, neither is (the step rules
+// need no position, so a drift: nothing but the residual rules sees one).
+TEST(FaultMonitor, AfterAResolverOffsetTheResidualRulesGoOnAgainstThePositionLessTheOffset) {
+  auto run = [](bool compensate, double drift_at_s) {
+    MonitorParams p = eol_params(1.5, false);
+    p.jump_compensate = compensate;
+    EolCaliper caliper{p};
+    auto& [eol, keys, T] = caliper;
+    FaultMonitor m(p, Target::FL);
+    SampleGuard g{MonitorParams{}.guard};
+    double x = 0.0;
+    for (int n = 1; n < 7000; ++n) {
+      const double t = 0.001 * n;
+      // Apply to 3.5 rev in 1 s, then modulate +/- 0.3 rev at 0.5 Hz.
+      const double speed = t < 1.0 ? 3.5 : 0.3 * M_PI * std::cos(M_PI * (t - 1.0));
+      x += 0.001 * speed;
+      const double drift_kN = drift_at_s > 0.0 && t >= drift_at_s ? 1.0 * (t - drift_at_s) : 0.0;
+      const double lc = eol.force_kN(x, T, 0.0) + keys.step(x) + drift_kN + 0.03 * ((n % 5) - 2);
+      const double offset_rev = t >= 2.0 && t < 4.0 ? 0.08 : 0.0;
+      const auto r = live_reading(n, t, x + offset_rev, speed + 0.004 * ((n % 3) - 1), lc, p);
+      const auto e = uncalibrated(lc);
+      const bool sensors_ok = m.ok(Part::LoadCell) && m.ok(Part::Resolver);
+      m.update(r, g.check(r), sensors_ok ? &e : nullptr, lc, t);
+    }
+    return std::pair{m.diagnosis(Part::Resolver), m.diagnosis(Part::LoadCell)};
+  };
+  const auto [resolver, healthy] = run(true, 0.0);
+  EXPECT_EQ(resolver.finding, Finding::ResolverOffset) << to_string(resolver.finding);
+  EXPECT_NEAR(resolver.detected_s, 2.01, 0.005);
+  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
+  for (double drift_at_s : {2.5, 4.5}) {
+    const double window_end_s = drift_at_s + 1.0 / 1.0 + 0.5;
+    const auto d = run(true, drift_at_s).second;
+    EXPECT_EQ(d.finding, Finding::LoadCellOffset) << to_string(d.finding);
+    EXPECT_GT(d.detected_s, drift_at_s);
+    EXPECT_LT(d.detected_s, window_end_s);
+    const auto without = run(false, drift_at_s).second;
+    EXPECT_TRUE(!without.present || without.detected_s > window_end_s) << without.detected_s;
+  }
+}
+
 // The hold rule's reference belongs to one way of computing the residual (extreme population,
 // 2026-11-26, run 75: a healthy stiff caliper named load_cell_offset). A slow apply (0.3 rev/s,
 // a hold to the rule) that begins a few samples before the end-of-line friction model's state

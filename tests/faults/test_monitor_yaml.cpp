@@ -50,7 +50,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(residual_on_profile_corners); SAME(residual_findings); SAME(residual_low_upper_bound);
   SAME(residual_sigma_factor); SAME(residual_stats_s); SAME(residual_stats_prior_s); SAME(residual_speed_kN_per_rev_per_s); SAME(residual_speed_free_rev_per_s);
   SAME(eol_band_kN); SAME(eol_relative); SAME(eol_speed_kN_per_rev_per_s); SAME(eol_friction_amplitude_factor);
-  SAME(jump_threshold_rev); SAME(jump_confirm_s); SAME(jump_window_s); SAME(jump_max_gap_s);
+  SAME(jump_threshold_rev); SAME(jump_confirm_s); SAME(jump_window_s); SAME(jump_max_gap_s); SAME(jump_compensate);
   SAME(stuck_samples); SAME(stuck_min_travel_rev); SAME(stuck_min_force_change_kN); SAME(frozen_attribution_samples);
   SAME(noise_window_samples); SAME(noise_step_kN); SAME(noise_second_difference_learn_s); SAME(noise_min_fraction); SAME(dropout_samples); SAME(dropout_clear_samples);
   SAME(torque_per_A_Nm); SAME(Nm_per_kN); SAME(inertia_kg_m2);

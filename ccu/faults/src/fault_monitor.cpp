@@ -217,13 +217,39 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   stuck_.update(c, p_, arbiter_);
   step_.update(c, p_, arbiter_);
   moving_step_.update(c, p_, arbiter_);
+  // A resolver named offset (and not stuck: the finding is its first) still measures the motion:
+  // less the offsets its confirmed jumps measured, the position the residual rules need.
+  const bool compensated = p_.jump_compensate && !arbiter_.ok(Part::Resolver) &&
+                           arbiter_.diagnosis(Part::Resolver).finding == Finding::ResolverOffset && p_.eol_curve;
+  if (jump_.began()) residual_.save_position();  // before this sample's step
   if (arbiter_.ok(Part::Resolver)) {
     residual_.track_position(r, p_);
+  } else if (compensated) {
+    // Each confirmed jump changes the offset; the samples between a jump and its confirmation
+    // had the wrong position: the position's state goes back to before the jump, the rules'
+    // references start again.
+    if (jump_.confirmed() != compensated_jumps_) {
+      compensated_jumps_ = jump_.confirmed();
+      residual_.restore_position();
+      residual_.restart_rules();
+    }
+    CornerReading corrected = r;
+    corrected.position_rev -= jump_.offset_rev();
+    residual_.track_position(corrected, p_);
   } else {
     residual_.forget_position();
   }
   if (estimate != nullptr && estimate->valid) {
     residual_.update(r, *estimate, p_, arbiter_, noise_, stuck_, jump_);
+  } else if (compensated && arbiter_.ok(Part::LoadCell) && check.load_cell_present && std::isfinite(r.force_kN)) {
+    // No calibrator here (it is fed only with both sensors right): the end-of-line curve and band.
+    CornerReading corrected = r;
+    corrected.position_rev -= jump_.offset_rev();
+    calibration::Estimate eol_only;
+    eol_only.valid = true;
+    eol_only.force_kN = r.force_kN;
+    eol_only.curve_force_kN = r.force_kN;
+    residual_.update(corrected, eol_only, p_, arbiter_, noise_, stuck_, jump_);
   } else if (!arbiter_.ok(Part::Resolver) && arbiter_.ok(Part::LoadCell) && have_prev_ && check.load_cell_present &&
              prev_lc_present_ && std::isfinite(r.force_kN) && std::isfinite(prev_.force_kN)) {
     // No residual without the position: a noisy load cell is still found by its own differences.

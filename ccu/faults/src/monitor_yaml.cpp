@@ -66,6 +66,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.jump_confirm_s = j.number("confirm_s", pos);
   p.jump_window_s = j.number("window_s", pos);
   p.jump_max_gap_s = j.number("max_gap_s", pos);
+  p.jump_compensate = j.boolean("compensate");
   j.finish();
 
   auto s = r.map("stuck");

@@ -8,6 +8,7 @@
 namespace bbw::faults {
 
 void JumpDetector::update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a) {
+  began_ = false;
   // Across a gap (samples the guard refused, a lost link) the speed no longer predicts the step.
   if (!c.have_prev || c.dt_s > p.jump_max_gap_s) return;
   const double t = c.r.time_s;
@@ -24,6 +25,7 @@ void JumpDetector::update(const SampleContext& c, const MonitorParams& p, Diagno
       jump_pending_ = false;  // undone: a glitch, not an offset
     } else {
       jump_pending_ = true;
+      began_ = true;
       pending_jump_rev_ = unexplained;
       pending_jump_s_ = t;
     }
@@ -31,6 +33,8 @@ void JumpDetector::update(const SampleContext& c, const MonitorParams& p, Diagno
   }
   if (jump_pending_ && t - pending_jump_s_ >= p.jump_confirm_s) {
     jump_pending_ = false;
+    offset_rev_ += pending_jump_rev_;
+    ++confirmed_;
     a.confirm(Finding::ResolverOffset, pending_jump_s_, t);
   }
 }

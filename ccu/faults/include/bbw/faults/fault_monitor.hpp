@@ -150,6 +150,10 @@ struct MonitorParams {
   double jump_confirm_s = 0.01;     // a jump not undone within this is an offset
   double jump_window_s = 0.05;      // a jump this recent explains a residual as the resolver's
   double jump_max_gap_s = 0.003;    // no prediction across a longer gap between usable samples
+  // After a resolver offset is named, the residual rules go on against the position less the
+  // offsets the confirmed jumps measured (the end-of-line curve and its band, as before a fit):
+  // a load-cell fault on the same corner stays visible. A stuck resolver has no such position.
+  bool jump_compensate = true;
 
   // Stuck channels: exactly repeated readings while the other channel moves.
   int stuck_samples = 20;
@@ -406,6 +410,7 @@ class FaultMonitor {
   LinkDetector link_;
   // The previous usable sample (continuity for the detectors; broken by a rejoin).
   bool have_prev_ = false;
+  int compensated_jumps_ = 0;  // the resolver's confirmed jumps the compensated residual started from
   CornerReading prev_{};
   bool prev_lc_present_ = false;
 };

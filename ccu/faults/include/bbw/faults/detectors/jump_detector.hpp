@@ -11,8 +11,17 @@ class JumpDetector {
  public:
   void update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a);
   double last_jump_s() const { return last_jump_s_; }
+  // The sum of the confirmed jumps (rev): what the resolver's offset is, if it is one; and how
+  // many were confirmed (each changes it).
+  double offset_rev() const { return offset_rev_; }
+  int confirmed() const { return confirmed_; }
+  // A jump began at the last sample (pending its confirmation).
+  bool began() const { return began_; }
 
  private:
+  double offset_rev_ = 0.0;
+  int confirmed_ = 0;
+  bool began_ = false;
   double last_jump_s_ = -1e300;
   double pending_jump_rev_ = 0.0;
   double pending_jump_s_ = 0.0;

@@ -43,12 +43,37 @@ class ResidualDetector {
   void update(const CornerReading& r, const calibration::Estimate& e, const MonitorParams& p, DiagnosisArbiter& a,
               NoiseDetector& noise, const StuckDetector& stuck, const JumpDetector& jump);
   void on_rejoin() {
+    restart_rules();
+    forget_position();  // the positions in the gap are unknown: so is the friction's state
+    saved_.reset();
+  }
+  // The rules' references and persistence start again (the position moved under them).
+  void restart_rules() {
     suspect_ = false;
     low_suspect_ = false;
     hold_ref_ = false;
     hold_slow_ = 0;
     hold_sum_kN_ = 0.0;
-    forget_position();  // the positions in the gap are unknown: so is the friction's state
+  }
+  // The position's state (the end-of-line friction model, the play, the sweep) before a resolver
+  // jump: taken back once the jump is confirmed as an offset, from where the positions less the
+  // offset go on (the Maxwell-slip model is rate-independent: the samples between the jump and
+  // its confirmation are one step). Without a saved state: forgotten.
+  void save_position() {
+    saved_ = SavedPosition{eol_friction_, friction_known_, have_x_, x_min_rev_, x_max_rev_, eol_friction_kN_, spindle_rev_};
+  }
+  void restore_position() {
+    if (!saved_) {
+      forget_position();
+      return;
+    }
+    eol_friction_ = saved_->friction;
+    friction_known_ = saved_->known;
+    have_x_ = saved_->have_x;
+    x_min_rev_ = saved_->x_min_rev;
+    x_max_rev_ = saved_->x_max_rev;
+    eol_friction_kN_ = saved_->friction_kN;
+    spindle_rev_ = saved_->spindle_rev;
   }
   // Whether the end-of-line friction model's state is known (the position has swept twice its
   // largest threshold since the start or the last gap), and its friction (kN).
@@ -121,6 +146,13 @@ class ResidualDetector {
   double x_min_rev_ = 0.0, x_max_rev_ = 0.0;  // since the start or the last gap
   double eol_friction_kN_ = 0.0;
   double spindle_rev_ = 0.0;  // the play operator's state (backlash)
+  struct SavedPosition {
+    std::optional<plant::KeyFriction> friction;
+    bool known;
+    bool have_x;
+    double x_min_rev, x_max_rev, friction_kN, spindle_rev;
+  };
+  std::optional<SavedPosition> saved_;
   // The hold rule's reference: the residual's level once the hold settled.
   bool hold_ref_ = false;
   bool hold_eol_mode_ = false;
