@@ -9,6 +9,7 @@
 
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/faults/corner_supervisor.hpp"
+#include "bbw/faults/detectors/jump_detector.hpp"
 #include "bbw/faults/fault_monitor.hpp"
 #include "bbw/faults/last_good.hpp"
 #include "bbw/faults/sample_guard.hpp"
@@ -1050,6 +1051,40 @@ TEST(FaultMonitor, AfterAResolverOffsetTheResidualRulesGoOnAgainstThePositionLes
     const auto without = run(false, drift_at_s).second;
     EXPECT_TRUE(!without.present || without.detected_s > window_end_s) << without.detected_s;
   }
+}
+
+// The sum of the confirmed jumps is the resolver's offset only while every step was seen. An
+// offset that began while the link was silent and ended in sight (CI subset run 32) left a sum of
+// the wrong sign, and the compensated residual named a healthy load cell: after a gap the offset
+// is no longer tracked (and the monitor no longer compensates).
+TEST(JumpDetector, AfterAGapTheSumOfTheJumpsIsNoLongerTheOffset) {
+  auto run = [](bool gap) {
+    JumpDetector jump;
+    DiagnosisArbiter a;
+    const MonitorParams p;
+    const SampleCheck check{};
+    CornerReading prev;
+    bool have_prev = false;
+    for (int n = 1; n < 400; ++n) {
+      if (gap && n >= 100 && n < 150) continue;  // the link is silent: the offset begins unseen
+      CornerReading r = at(static_cast<std::uint64_t>(n), 0.001 * n, n >= 120 && n < 300 ? -0.2 : 0.0, 10.0);
+      const SampleContext c{r, check, have_prev, prev, true, have_prev ? r.time_s - prev.time_s : 0.0};
+      jump.update(c, p, a);
+      prev = r;
+      have_prev = true;
+    }
+    return std::pair{jump, a.diagnosis(Part::Resolver)};
+  };
+  const auto [seen, seen_d] = run(false);
+  EXPECT_EQ(seen_d.finding, Finding::ResolverOffset);
+  EXPECT_TRUE(seen.offset_tracked());
+  EXPECT_EQ(seen.confirmed(), 2);                 // on at 0.12 s, off at 0.3 s
+  EXPECT_NEAR(seen.offset_rev(), 0.0, 1e-9);
+  const auto [hidden, hidden_d] = run(true);
+  EXPECT_EQ(hidden_d.finding, Finding::ResolverOffset);  // its end
+  EXPECT_EQ(hidden.confirmed(), 1);
+  EXPECT_NEAR(hidden.offset_rev(), 0.2, 1e-9);           // the wrong sign: not the offset (0 now)
+  EXPECT_FALSE(hidden.offset_tracked());
 }
 
 // The hold rule's reference belongs to one way of computing the residual (extreme population,

@@ -219,7 +219,10 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   moving_step_.update(c, p_, arbiter_);
   // A resolver named offset (and not stuck: the finding is its first) still measures the motion:
   // less the offsets its confirmed jumps measured, the position the residual rules need.
-  const bool compensated = p_.jump_compensate && !arbiter_.ok(Part::Resolver) &&
+  // Only while every step since the start was seen: an offset that began in a gap (a silent
+  // link) and ended in sight left a sum of the wrong sign (CI subset run 32, a faulty run's
+  // unexplained load_cell_offset).
+  const bool compensated = p_.jump_compensate && jump_.offset_tracked() && !arbiter_.ok(Part::Resolver) &&
                            arbiter_.diagnosis(Part::Resolver).finding == Finding::ResolverOffset && p_.eol_curve;
   if (jump_.began()) residual_.save_position();  // before this sample's step
   if (arbiter_.ok(Part::Resolver)) {

@@ -9,8 +9,14 @@ namespace bbw::faults {
 
 void JumpDetector::update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a) {
   began_ = false;
-  // Across a gap (samples the guard refused, a lost link) the speed no longer predicts the step.
-  if (!c.have_prev || c.dt_s > p.jump_max_gap_s) return;
+  // Across a gap (samples the guard refused, a lost link) the speed no longer predicts the step,
+  // and a jump within it goes unseen.
+  if (!c.have_prev || c.dt_s > p.jump_max_gap_s) {
+    if (started_) tracked_ = false;
+    started_ = true;
+    return;
+  }
+  started_ = true;
   const double t = c.r.time_s;
   // The step is explained anywhere between what the two measured speeds give over the interval
   // (the speed changed monotonically within it): a drive that seizes at 20 rev/s stops within one

@@ -15,6 +15,9 @@ class JumpDetector {
   // many were confirmed (each changes it).
   double offset_rev() const { return offset_rev_; }
   int confirmed() const { return confirmed_; }
+  // Whether every step since the first sample was seen: a gap (a lost link, refused samples) may
+  // hide a jump, and then the sum of the confirmed ones is not the offset.
+  bool offset_tracked() const { return tracked_; }
   // A jump began at the last sample (pending its confirmation).
   bool began() const { return began_; }
 
@@ -22,6 +25,8 @@ class JumpDetector {
   double offset_rev_ = 0.0;
   int confirmed_ = 0;
   bool began_ = false;
+  bool started_ = false;
+  bool tracked_ = true;
   double last_jump_s_ = -1e300;
   double pending_jump_rev_ = 0.0;
   double pending_jump_s_ = 0.0;
