@@ -671,15 +671,6 @@ TEST(ClosedLoopIssue14, ADriftBelowTheTrustedRangeIsNamedByTheCurvesUpperBound) 
                                             [](MonitorParams& m) { m.residual_low_upper_bound = false; });
 }
 
-// The same below the trusted range once the end-of-line friction model's state is known (the
-// first apply swept it): the load cell less the model's friction, against its share of the
-// half-width (tuning seed 1408 run 73: named at 2.82 s with the whole half-width, window 1.5 s).
-TEST(ClosedLoopIssue14, ADriftBelowTheTrustedRangeIsJudgedLessTheModelledFriction) {
-  expect_named_in_window_only_with_the_rule(
-      "config/scenarios/faults/load_cell_drift_below_the_trusted_range_friction_known.yaml",
-      "the modelled friction below the trusted range", [](MonitorParams& m) { m.residual_low_modelled_friction = false; });
-}
-
 // The end-of-line friction model follows the position while the load cell gives no value: the
 // dropout's finding clears when the load cell is back and nothing else is raised (tuning seed
 // 1401 run 244: a false load_cell_offset 20 ms after it cleared, the model left where the

@@ -65,11 +65,10 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
       types.insert(fs.faults.faults[0].type);
     }
   }
-  EXPECT_EQ(files, 27u);  // actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four
+  EXPECT_EQ(files, 26u);  // actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four
                           // times: in a hold, while applying, before the first fit, in a hard stop released on the
-                          // curve; load_cell drift five times: in a stop, followed by the loop in a hard stop,
-                          // while the brake modulates, below the trusted range (twice: the friction's state unknown,
-                          // known); load_cell dropout twice: in a
+                          // curve; load_cell drift four times: in a stop, followed by the loop in a hard stop,
+                          // while the brake modulates, below the trusted range; load_cell dropout twice: in a
                           // stop, across a reversal; torque_loss twice: applying, in a hold; a load-cell drift
                           // then a resolver offset on one corner
   EXPECT_EQ(standby_files, 4u);  // ccu_failover_{kill,hang,link_cut,both_lost}

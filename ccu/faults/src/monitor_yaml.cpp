@@ -56,7 +56,6 @@ MonitorParams read_monitor_params(Reader& r) {
     h.finish();
   }
   p.residual_low_upper_bound = res.boolean("low_upper_bound");
-  p.residual_low_modelled_friction = res.boolean("low_modelled_friction");
   p.curve_min_rev = res.number("curve_min_rev");
   p.curve_max_rev = res.number("curve_max_rev");
   p.residual_on_profile_corners = res.boolean("on_profile_corners");

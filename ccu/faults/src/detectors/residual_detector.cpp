@@ -97,12 +97,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   bool low_over = false;
   if (eol_ && !above_min && p.residual_low_upper_bound && p.residual_findings && std::isfinite(r.force_kN)) {
     const double f_hi_kN = std::max(0.0, eol_->force_kN(r.position_rev + 0.5 * p.eol_backlash_rev, temperature_C, 0.0));
-    // The keys' friction: its end-of-line model once its state is known (within its share of the
-    // width), else anywhere within its width.
-    const bool modelled = friction_known_ && p.residual_low_modelled_friction;
-    const double friction_kN = modelled ? eol_friction_kN_ : 0.0;
-    const double friction_band_kN = (modelled ? p.eol_friction_model_share : 1.0) * p.eol_friction_half_width_kN;
-    low_over = r.force_kN - friction_kN - f_hi_kN > eol_allowance_kN(p, p.eol_band_kN, friction_band_kN, f_hi_kN, r.speed_rev_per_s);
+    low_over = r.force_kN - f_hi_kN > eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_half_width_kN, f_hi_kN, r.speed_rev_per_s);
   }
   if (!low_over) {
     low_suspect_ = false;

@@ -144,10 +144,6 @@ struct MonitorParams {
   // above only. A positive drift the loop follows by releasing drives the pads below the trusted
   // range, where the two-sided rules do not look (tune_bias run 73).
   bool residual_low_upper_bound = true;
-  // ... and once the end-of-line friction model's state is known, the load cell less that
-  // model's friction, with its share of the half-width instead of the whole (as the band above
-  // the trusted range): the keys' state is followed below the range too.
-  bool residual_low_modelled_friction = true;
 
   // Resolver consistency: a position step the measured speed does not explain.
   double jump_threshold_rev = 0.01;
