@@ -63,7 +63,7 @@ std::string small_spec_with(const std::string& dir, int runs, const std::string&
 // ratchet: it fails when the diagnosis gets worse than measured, and its bounds move to the goal
 // as the diagnosis improves (kMinDetected up to n, the false-alarm bounds down to 0).
 TEST(CampaignSystem, CiSubsetOverDdsIsNoWorseThanMeasured) {
-  constexpr int kMinDetected = 36;             // goal: every fault (35 before the fifteenth session, 34 before the thirteenth, 32 before the twelfth, 25 before the fourth session's rules)
+  constexpr int kMinDetected = 38;             // goal: every fault (36 before the sixteenth session, 35 before the fifteenth, 34 before the thirteenth, 32 before the twelfth, 25 before the fourth session's rules)
   constexpr int kMaxFalseAlarmsFaultFree = 0;  // the goal, met since the fifth session (1 before it, 2 before credible fits, 3 before the friction memory, 5 before the local loop's fix)
   constexpr int kMaxFalseAlarmsFaulty = 0;     // the goal, met since the sixth session (1 before it; 2 before the fourth session's rules, 8 before credible fits, 9 before the friction memory, 13 before the local loop's fix)
   const std::string dir = bbw::system_test::scratch("campaign", "ci");
