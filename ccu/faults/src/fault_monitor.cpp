@@ -225,6 +225,8 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   const bool compensated = p_.jump_compensate && jump_.offset_tracked() && !arbiter_.ok(Part::Resolver) &&
                            arbiter_.diagnosis(Part::Resolver).finding == Finding::ResolverOffset && p_.eol_curve;
   if (jump_.began()) residual_.save_position();  // before this sample's step
+  CornerReading corrected = r;
+  if (compensated) corrected.position_rev -= jump_.offset_rev();
   if (arbiter_.ok(Part::Resolver)) {
     residual_.track_position(r, p_);
   } else if (compensated) {
@@ -236,8 +238,6 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
       residual_.restore_position();
       residual_.restart_rules();
     }
-    CornerReading corrected = r;
-    corrected.position_rev -= jump_.offset_rev();
     residual_.track_position(corrected, p_);
   } else {
     residual_.forget_position();
@@ -246,8 +246,6 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
     residual_.update(r, *estimate, p_, arbiter_, noise_, stuck_, jump_);
   } else if (compensated && arbiter_.ok(Part::LoadCell) && check.load_cell_present && std::isfinite(r.force_kN)) {
     // No calibrator here (it is fed only with both sensors right): the end-of-line curve and band.
-    CornerReading corrected = r;
-    corrected.position_rev -= jump_.offset_rev();
     calibration::Estimate eol_only;
     eol_only.valid = true;
     eol_only.force_kN = r.force_kN;

@@ -45,7 +45,7 @@ class ResidualDetector {
   void on_rejoin() {
     restart_rules();
     forget_position();  // the positions in the gap are unknown: so is the friction's state
-    saved_.reset();
+    have_saved_ = false;
   }
   // The rules' references and persistence start again (the position moved under them).
   void restart_rules() {
@@ -58,22 +58,30 @@ class ResidualDetector {
   // The position's state (the end-of-line friction model, the play, the sweep) before a resolver
   // jump: taken back once the jump is confirmed as an offset, from where the positions less the
   // offset go on (the Maxwell-slip model is rate-independent: the samples between the jump and
-  // its confirmation are one step). Without a saved state: forgotten.
+  // its confirmation are one step). Without a saved state: forgotten. (The copy's storage is
+  // made at construction: no allocation per sample.)
   void save_position() {
-    saved_ = SavedPosition{eol_friction_, friction_known_, have_x_, x_min_rev_, x_max_rev_, eol_friction_kN_, spindle_rev_};
+    saved_.friction = eol_friction_;
+    saved_.known = friction_known_;
+    saved_.have_x = have_x_;
+    saved_.x_min_rev = x_min_rev_;
+    saved_.x_max_rev = x_max_rev_;
+    saved_.friction_kN = eol_friction_kN_;
+    saved_.spindle_rev = spindle_rev_;
+    have_saved_ = true;
   }
   void restore_position() {
-    if (!saved_) {
+    if (!have_saved_) {
       forget_position();
       return;
     }
-    eol_friction_ = saved_->friction;
-    friction_known_ = saved_->known;
-    have_x_ = saved_->have_x;
-    x_min_rev_ = saved_->x_min_rev;
-    x_max_rev_ = saved_->x_max_rev;
-    eol_friction_kN_ = saved_->friction_kN;
-    spindle_rev_ = saved_->spindle_rev;
+    eol_friction_ = saved_.friction;
+    friction_known_ = saved_.known;
+    have_x_ = saved_.have_x;
+    x_min_rev_ = saved_.x_min_rev;
+    x_max_rev_ = saved_.x_max_rev;
+    eol_friction_kN_ = saved_.friction_kN;
+    spindle_rev_ = saved_.spindle_rev;
   }
   // Whether the end-of-line friction model's state is known (the position has swept twice its
   // largest threshold since the start or the last gap), and its friction (kN).
@@ -148,11 +156,12 @@ class ResidualDetector {
   double spindle_rev_ = 0.0;  // the play operator's state (backlash)
   struct SavedPosition {
     std::optional<plant::KeyFriction> friction;
-    bool known;
-    bool have_x;
-    double x_min_rev, x_max_rev, friction_kN, spindle_rev;
+    bool known = false;
+    bool have_x = false;
+    double x_min_rev = 0.0, x_max_rev = 0.0, friction_kN = 0.0, spindle_rev = 0.0;
   };
-  std::optional<SavedPosition> saved_;
+  SavedPosition saved_;
+  bool have_saved_ = false;
   // The hold rule's reference: the residual's level once the hold settled.
   bool hold_ref_ = false;
   bool hold_eol_mode_ = false;
