@@ -22,6 +22,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -220,13 +221,29 @@ int cmd_run(const std::string& dir, int index, const std::string& transport, boo
   }
   fs::create_directories(out);
   const auto t0 = std::chrono::steady_clock::now();
-  runtime::Child child("run " + std::to_string(index), argv, rd + "/run.out", rd + "/run.err");
-  const auto st = child.wait_until(runtime::Clock::now() + std::chrono::minutes(30));
+  // Over Fast DDS a process can abort inside Fast DDS 2.9's own discovery
+  // (`PDP.cpp: check_remote_participant_liveliness: Assertion ...`, left on in Debian's build; a
+  // race bbw cannot reach, docs/faults.md "Realtime restart"). That one upstream failure, and only
+  // it, runs the run again (at most twice), its log kept as run.err.<attempt> and said on stderr.
+  std::optional<runtime::ExitStatus> st;
+  for (int attempt = 1;; ++attempt) {
+    fs::remove_all(out);
+    fs::create_directories(out);
+    runtime::Child child("run " + std::to_string(index), argv, rd + "/run.out", rd + "/run.err");
+    st = child.wait_until(runtime::Clock::now() + std::chrono::minutes(30));
+    if (!st) child.stop(std::chrono::milliseconds(2000));
+    const std::string err = slurp(rd + "/run.err");
+    const bool upstream_abort = transport == "dds" && st && !st->ok() && err.find("PDP.cpp") != std::string::npos &&
+                                err.find("Assertion") != std::string::npos;
+    if (!upstream_abort || attempt == 3) break;
+    fs::rename(rd + "/run.err", rd + "/run.err." + std::to_string(attempt));
+    std::fprintf(stderr, "bbw_campaign: NOTE run %d: a process aborted in Fast DDS's discovery (PDP.cpp assertion); run again (%s)\n",
+                 index, (rd + "/run.err." + std::to_string(attempt)).c_str());
+  }
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!st || !st->ok()) {
     r.ok = false;
     r.error = std::string(argv[0]) + " " + (st ? st->describe() : "did not end within 30 min") + " (see " + rd + "/run.err)";
-    if (!st) child.stop(std::chrono::milliseconds(2000));
   } else {
     try {
       const auto detections = transport == "dds" ? detections_from_stats(out + "/ccu.stats") : detections_from_csv(out + "/detections.csv");
