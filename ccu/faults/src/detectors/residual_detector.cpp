@@ -32,7 +32,7 @@ ResidualDetector::ResidualDetector(const MonitorParams& p)
     plant::KeyFrictionParams k = *p.eol_key_friction;
     k.initial_deflection = 0.0;  // the state at the start is unknown: found by sweeping
     eol_friction_.emplace(k);
-    saved_.friction = eol_friction_;  // the saved state's storage, made once
+    std::get<0>(saved_) = eol_friction_;  // the saved state's storage, made once
     sweep_rev_ = 2.0 * eol_friction_->thresholds_rev().back();
   }
 }

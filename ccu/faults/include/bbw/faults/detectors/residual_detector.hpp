@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <tuple>
 
 #include "bbw/calibration/calibrator.hpp"
 #include "bbw/faults/detectors/detector.hpp"
@@ -61,27 +62,12 @@ class ResidualDetector {
   // its confirmation are one step). Without a saved state: forgotten. (The copy's storage is
   // made at construction: no allocation per sample.)
   void save_position() {
-    saved_.friction = eol_friction_;
-    saved_.known = friction_known_;
-    saved_.have_x = have_x_;
-    saved_.x_min_rev = x_min_rev_;
-    saved_.x_max_rev = x_max_rev_;
-    saved_.friction_kN = eol_friction_kN_;
-    saved_.spindle_rev = spindle_rev_;
+    saved_ = position_state();
     have_saved_ = true;
   }
   void restore_position() {
-    if (!have_saved_) {
-      forget_position();
-      return;
-    }
-    eol_friction_ = saved_.friction;
-    friction_known_ = saved_.known;
-    have_x_ = saved_.have_x;
-    x_min_rev_ = saved_.x_min_rev;
-    x_max_rev_ = saved_.x_max_rev;
-    eol_friction_kN_ = saved_.friction_kN;
-    spindle_rev_ = saved_.spindle_rev;
+    if (have_saved_) position_state() = saved_;
+    else forget_position();
   }
   // Whether the end-of-line friction model's state is known (the position has swept twice its
   // largest threshold since the start or the last gap), and its friction (kN).
@@ -154,13 +140,11 @@ class ResidualDetector {
   double x_min_rev_ = 0.0, x_max_rev_ = 0.0;  // since the start or the last gap
   double eol_friction_kN_ = 0.0;
   double spindle_rev_ = 0.0;  // the play operator's state (backlash)
-  struct SavedPosition {
-    std::optional<plant::KeyFriction> friction;
-    bool known = false;
-    bool have_x = false;
-    double x_min_rev = 0.0, x_max_rev = 0.0, friction_kN = 0.0, spindle_rev = 0.0;
-  };
-  SavedPosition saved_;
+  // The position's state, one list for saving and taking it back.
+  std::tuple<std::optional<plant::KeyFriction>&, bool&, bool&, double&, double&, double&, double&> position_state() {
+    return std::tie(eol_friction_, friction_known_, have_x_, x_min_rev_, x_max_rev_, eol_friction_kN_, spindle_rev_);
+  }
+  std::tuple<std::optional<plant::KeyFriction>, bool, bool, double, double, double, double> saved_{std::nullopt, false, false, 0.0, 0.0, 0.0, 0.0};
   bool have_saved_ = false;
   // The hold rule's reference: the residual's level once the hold settled.
   bool hold_ref_ = false;
