@@ -671,6 +671,51 @@ TEST(ClosedLoopIssue14, ADriftBelowTheTrustedRangeIsNamedByTheCurvesUpperBound) 
                                             [](MonitorParams& m) { m.residual_low_upper_bound = false; });
 }
 
+// Two faults on one corner, the first a load-cell drift: each named rightly in its window (the
+// drift only with the rule), nothing else raised.
+void expect_the_drift_named_only_with_the_rule(const std::string& file, const char* rule,
+                                               const std::function<void(MonitorParams&)>& without) {
+  const auto fs = load(file);
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 2u);
+  for (const auto& o : r.outcomes) EXPECT_TRUE(o.detected) << to_string(o.fault.type) << " " << to_string(o.diagnosis);
+  EXPECT_EQ(r.faults_raised(), 2u);
+  auto opts = default_options();
+  without(opts.monitor);
+  const auto base = run_closed_loop(fs, opts);
+  ASSERT_EQ(base.outcomes.size(), 2u);
+  EXPECT_FALSE(base.outcomes[0].detected);  // the drift
+  EXPECT_TRUE(base.outcomes[1].detected);   // the actuator
+  std::printf("drift with %s: named after %.0f ms; without: %s after %.0f ms (window %.0f ms)\n", rule,
+              r.outcomes[0].latency_ms, to_string(base.outcomes[0].diagnosis), base.outcomes[0].diagnosis_latency_ms,
+              1e3 * detection_window_s(fs.faults.faults[0]));
+}
+
+// A load-cell drift, then the actuator lost and released: the pads below the trusted range, the
+// load cell below 0 by more than the keys can pull it (stress seed 1406 run 161).
+TEST(ClosedLoopIssue14, ADriftBelowZeroOnAReleasedCaliperIsNamedByTheLowerBound) {
+  expect_the_drift_named_only_with_the_rule("config/scenarios/faults/load_cell_drift_then_a_total_loss_released.yaml",
+                                            "the lower bound below the trusted range",
+                                            [](MonitorParams& m) { m.residual_low_lower_bound = false; });
+}
+
+// A load-cell drift on a drive seized at the pads' contact, below the trusted range: nothing
+// moves, so the load cell's level may not change (tuning seed 1401 run 57).
+TEST(ClosedLoopIssue14, ADriftOnACaliperSeizedBelowTheTrustedRangeIsNamedByTheStillDriveRule) {
+  expect_the_drift_named_only_with_the_rule("config/scenarios/faults/load_cell_drift_on_a_seized_caliper_at_the_pads.yaml",
+                                            "the still-drive rule below the trusted range",
+                                            [](MonitorParams& m) { m.residual_low_static_span_rev = 0.0; });
+}
+
+// A total loss while a hard stop applies at the speed limit: the motor brakes with -40 A and the
+// rotor coasts on (tuning seed 1403 run 158). Named lost by the braking rule in its window; never
+// without it.
+TEST(ClosedLoopIssue14, ATotalLossWhileApplyingAtSpeedIsNamedByTheBrakingRule) {
+  expect_named_in_window_only_with_the_rule("config/scenarios/faults/total_loss_while_applying_at_speed.yaml",
+                                            "the lost rule while braking at speed",
+                                            [](MonitorParams& m) { m.torque_lost_braking = false; });
+}
+
 // The end-of-line friction model follows the position while the load cell gives no value: the
 // dropout's finding clears when the load cell is back and nothing else is raised (tuning seed
 // 1401 run 244: a false load_cell_offset 20 ms after it cleared, the model left where the

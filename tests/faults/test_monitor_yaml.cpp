@@ -47,7 +47,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(guard.max_sequence_jump); SAME(guard.max_time_jump_s);
   SAME(residual_threshold_kN); SAME(uncalibrated_residual_threshold_kN); SAME(residual_persist_s);
   SAME(residual_reference_s); SAME(residual_change_threshold_kN); SAME(curve_min_rev); SAME(curve_max_rev);
-  SAME(residual_on_profile_corners); SAME(residual_findings); SAME(residual_low_upper_bound);
+  SAME(residual_on_profile_corners); SAME(residual_findings); SAME(residual_low_upper_bound); SAME(residual_low_lower_bound); SAME(residual_low_static_span_rev);
   SAME(residual_sigma_factor); SAME(residual_stats_s); SAME(residual_stats_prior_s); SAME(residual_speed_kN_per_rev_per_s); SAME(residual_speed_free_rev_per_s);
   SAME(eol_band_kN); SAME(eol_relative); SAME(eol_speed_kN_per_rev_per_s); SAME(eol_friction_amplitude_factor);
   SAME(jump_threshold_rev); SAME(jump_confirm_s); SAME(jump_window_s); SAME(jump_max_gap_s); SAME(jump_compensate);
@@ -57,7 +57,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(torque_filter_s); SAME(torque_check_min_load_kN); SAME(torque_check_min_torque_Nm);
   SAME(torque_fraction_threshold); SAME(torque_check_max_speed_rev_per_s); SAME(torque_check_moving_min_speed_rev_per_s); SAME(torque_check_moving_min_load_kN);
   SAME(torque_persist_s);
-  SAME(torque_lost_threshold); SAME(torque_lost_persist_s); SAME(torque_loss_rescales_drive); SAME(torque_lost_unmeasured_load_high);
+  SAME(torque_lost_threshold); SAME(torque_lost_persist_s); SAME(torque_loss_rescales_drive); SAME(torque_lost_unmeasured_load_high); SAME(torque_lost_braking);
   SAME(test_pulse_max_speed_rev_per_s); SAME(test_pulse_answer_ratio); SAME(test_pulse_unanswered); SAME(test_pulse_within_s);
   SAME(test_pulse_lost_mean_ratio); SAME(test_pulse_weak_count); SAME(test_pulse_weak_fraction);
   SAME(test_pulse_healthy_ratio); SAME(test_pulse_learn_count);

@@ -56,7 +56,9 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
     ++files;
     if (fs.scenario.name == "fault_free_stop") {
       EXPECT_TRUE(fs.faults.empty());
-    } else if (fs.scenario.name == "load_cell_drift_then_a_resolver_offset") {  // two faults, one corner
+    } else if (fs.scenario.name == "load_cell_drift_then_a_resolver_offset" ||
+               fs.scenario.name == "load_cell_drift_then_a_total_loss_released" ||
+               fs.scenario.name == "load_cell_drift_on_a_seized_caliper_at_the_pads") {  // two faults, one corner
       ASSERT_EQ(fs.faults.faults.size(), 2u) << entry.path();
       EXPECT_EQ(fs.faults.faults[0].target, fs.faults.faults[1].target);
       for (const auto& f : fs.faults.faults) types.insert(f.type);
@@ -65,12 +67,14 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
       types.insert(fs.faults.faults[0].type);
     }
   }
-  EXPECT_EQ(files, 26u);  // actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four
+  EXPECT_EQ(files, 29u);  // actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four
                           // times: in a hold, while applying, before the first fit, in a hard stop released on the
                           // curve; load_cell drift four times: in a stop, followed by the loop in a hard stop,
                           // while the brake modulates, below the trusted range; load_cell dropout twice: in a
                           // stop, across a reversal; torque_loss twice: applying, in a hold; a load-cell drift
-                          // then a resolver offset on one corner
+                          // then a resolver offset on one corner; a load-cell drift then a total loss, released, on
+                          // one corner; a load-cell drift on a caliper seized at the pads; a total loss while
+                          // applying at speed
   EXPECT_EQ(standby_files, 4u);  // ccu_failover_{kill,hang,link_cut,both_lost}
   EXPECT_EQ(types.size(), 14u);  // every FaultType; stuck appears for both sensors
 }

@@ -56,6 +56,8 @@ MonitorParams read_monitor_params(Reader& r) {
     h.finish();
   }
   p.residual_low_upper_bound = res.boolean("low_upper_bound");
+  p.residual_low_lower_bound = res.boolean("low_lower_bound");
+  p.residual_low_static_span_rev = res.number("low_static_span_rev", config::Range::non_negative());
   p.curve_min_rev = res.number("curve_min_rev");
   p.curve_max_rev = res.number("curve_max_rev");
   p.residual_on_profile_corners = res.boolean("on_profile_corners");
@@ -134,6 +136,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.torque_lost_persist_s = t.number("lost_persist_s", pos);
   p.torque_loss_rescales_drive = t.boolean("loss_rescales_drive");
   p.torque_lost_unmeasured_load_high = t.boolean("lost_unmeasured_load_high");
+  p.torque_lost_braking = t.boolean("lost_braking");
   p.unexplained_margin_Nm = t.number("unexplained_margin_Nm", pos);
   p.unexplained_relative = t.number("unexplained_relative", Range::closed(0.0, 10.0));
   p.unexplained_max_speed_rev_per_s = t.number("unexplained_max_speed_rev_per_s", pos);

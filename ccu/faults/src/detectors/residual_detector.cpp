@@ -58,6 +58,32 @@ void ResidualDetector::track_position(const CornerReading& r, const MonitorParam
   if (r.position_rev - x_min_rev_ >= sweep_rev || x_max_rev_ - r.position_rev >= sweep_rev) friction_known_ = true;
 }
 
+bool ResidualDetector::static_changed(const CornerReading& r, double temperature_C, const MonitorParams& p) {
+  const double curve_kN = eol_->force_kN(r.position_rev, temperature_C, 0.0);
+  const double level_kN = r.force_kN - curve_kN;
+  const bool still = std::abs(r.speed_rev_per_s) < p.hold_speed_rev_per_s &&
+                     (static_count_ == 0 || std::abs(r.position_rev - static_x0_rev_) <= p.residual_low_static_span_rev);
+  if (!still) {
+    static_ref_ = false;
+    static_count_ = 0;
+  }
+  if (!static_ref_) {
+    if (static_count_ == 0) {
+      static_x0_rev_ = r.position_rev;
+      static_sum_kN_ = 0.0;
+    }
+    ++static_count_;
+    static_sum_kN_ += level_kN;
+    if (static_count_ >= p.hold_settle_samples) {
+      static_ref_ = true;
+      static_level_kN_ = static_sum_kN_ / static_count_;
+      static_curve_kN_ = curve_kN;
+    }
+    return false;
+  }
+  return std::abs(level_kN - static_level_kN_) > eol_allowance_kN(p, p.hold_kN, 0.0, curve_kN - static_curve_kN_, r.speed_rev_per_s);
+}
+
 void ResidualDetector::update(const CornerReading& r, const calibration::Estimate& e, const MonitorParams& p,
                               DiagnosisArbiter& a, NoiseDetector& noise, const StuckDetector& stuck,
                               const JumpDetector& jump) {
@@ -99,6 +125,19 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   if (eol_ && !above_min && p.residual_low_upper_bound && p.residual_findings && std::isfinite(r.force_kN)) {
     const double f_hi_kN = std::max(0.0, eol_->force_kN(r.position_rev + 0.5 * p.eol_backlash_rev, temperature_C, 0.0));
     low_over = r.force_kN - f_hi_kN > eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_half_width_kN, f_hi_kN, r.speed_rev_per_s);
+  }
+  // From below: the clamp force is never negative, and the keys pull the reading below it by at
+  // most their half-width, wherever the pads are (a negative drift on a released or fallen-back
+  // caliper, tuning seed 1403 run 124: -1.6 kN at no clamp force, never named).
+  if (eol_ && !above_min && p.residual_low_lower_bound && p.residual_findings && std::isfinite(r.force_kN)) {
+    low_over = low_over ||
+               -r.force_kN > eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_half_width_kN, 0.0, r.speed_rev_per_s);
+  }
+  if (eol_ && !above_min && p.residual_low_static_span_rev > 0.0 && p.residual_findings && std::isfinite(r.force_kN)) {
+    low_over = static_changed(r, temperature_C, p) || low_over;
+  } else {
+    static_ref_ = false;
+    static_count_ = 0;
   }
   if (!low_over) {
     low_suspect_ = false;

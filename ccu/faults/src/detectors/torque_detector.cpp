@@ -80,7 +80,17 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // 2.0 kN of key friction; lost at 20.9 s).
   const double judged_fraction =
       !checkable || load_cell_load || !p.torque_lost_unmeasured_load_high ? fraction : std::max(fraction, need_hi_Nm_ / make_Nm_);
-  if (checkable && judged_fraction / motor_scale_ < p.torque_lost_threshold) {
+  // Braking at speed: a healthy drive's made torque is the need plus the friction against the
+  // motion, whatever their signs. On a caliper with play the motor crosses the gap carrying none
+  // of the load (the spindle's own friction holds it: tuning seed 1401 run 57, a healthy corner
+  // backing off at 29 kN): there the need is the largest the motor may not carry, the load less.
+  const bool braking = load_cell_load && p.torque_lost_braking && p.torque_check_moving_min_speed_rev_per_s > 0.0 &&
+                       make_Nm_ <= -p.torque_check_min_torque_Nm &&
+                       std::abs(r.speed_rev_per_s) >= p.torque_check_moving_min_speed_rev_per_s;
+  const double carried_Nm = p.eol_backlash_rev > 0.0 ? std::max(0.0, load_kN) * p.Nm_per_kN : 0.0;
+  const bool lost_braking =
+      braking && (need_Nm_ - carried_Nm + friction_Nm_) / make_Nm_ / motor_scale_ < p.torque_lost_threshold;
+  if ((checkable && judged_fraction / motor_scale_ < p.torque_lost_threshold) || lost_braking) {
     if (!lost_suspect_) {
       lost_suspect_ = true;
       lost_onset_s_ = t;

@@ -144,6 +144,15 @@ struct MonitorParams {
   // above only. A positive drift the loop follows by releasing drives the pads below the trusted
   // range, where the two-sided rules do not look (tune_bias run 73).
   bool residual_low_upper_bound = true;
+  // ... and from below, wherever the pads are: the clamp force is never negative, so a load cell
+  // more than the key friction's half-width + the band below 0 reads an offset.
+  bool residual_low_lower_bound = true;
+  // ... and, there, a drive that does not move: while the motor's position stays within
+  // residual_low_static_span_rev of where it settled (hold_speed_rev_per_s, hold_settle_samples),
+  // the keys cannot slip and the pads cannot move, so the load cell keeps its level within
+  // hold_kN + eol_relative x the curve's change (the temperature) + the speed term (a drift on a
+  // seized caliper at the pads' contact, tuning seed 1401 run 57). 0: off.
+  double residual_low_static_span_rev = 5.0e-4;
 
   // Resolver consistency: a position step the measured speed does not explain.
   double jump_threshold_rev = 0.01;
@@ -262,6 +271,13 @@ struct MonitorParams {
   // decelerated against more load than an uncalibrated curve says looked as if its torque went
   // nowhere).
   bool torque_lost_unmeasured_load_high = true;
+  // The lost rule also while the motor brakes the rotor at speed (its torque against the motion
+  // at least torque_check_min_torque_Nm, at torque_check_moving_min_speed_rev_per_s or faster, the
+  // load cell's load): the rotor's deceleration needs the load, the acceleration and the drive's
+  // friction from the motor; a motor without torque leaves the load and the friction alone to
+  // stop it (tuning seed 1403 run 158: a total loss at 25 rev/s in a hard stop's apply coasted the
+  // caliper to 70 kN against -40 A and was never named).
+  bool torque_lost_braking = true;
   // Unexplained torque (issue 14: a seized drive or a motor that makes no torque, at any load):
   // near standstill, the measured current's torque against what the load, the acceleration and
   // the drive's friction need. Pushing: make - need > drive.coulomb_friction_Nm + unexplained_margin_Nm

@@ -55,6 +55,8 @@ class ResidualDetector {
     hold_ref_ = false;
     hold_slow_ = 0;
     hold_sum_kN_ = 0.0;
+    static_ref_ = false;
+    static_count_ = 0;
   }
   // The position's state (the end-of-line friction model, the play, the sweep) before a resolver
   // jump: taken back once the jump is confirmed as an offset, from where the positions less the
@@ -104,6 +106,16 @@ class ResidualDetector {
   // The rule below the trusted range (residual_low_upper_bound): its own persistence.
   bool low_suspect_ = false;
   double low_onset_s_ = 0.0;
+  // Its still-drive rule (residual_low_static_span_rev): samples averaged, the settled level,
+  // where the motor settled and the curve there.
+  bool static_ref_ = false;
+  int static_count_ = 0;
+  double static_sum_kN_ = 0.0;
+  double static_level_kN_ = 0.0;
+  double static_x0_rev_ = 0.0;
+  double static_curve_kN_ = 0.0;
+  // Below the trusted range: whether the load cell left the still drive's level.
+  bool static_changed(const CornerReading& r, double temperature_C, const MonitorParams& p);
   // Names the channel that explains a disagreement that began at onset_s and confirms it.
   void isolate(double onset_s, double t, const MonitorParams& p, DiagnosisArbiter& a, const StuckDetector& stuck,
                const JumpDetector& jump) const;
