@@ -671,10 +671,10 @@ TEST(ClosedLoopIssue14, ADriftBelowTheTrustedRangeIsNamedByTheCurvesUpperBound) 
                                             [](MonitorParams& m) { m.residual_low_upper_bound = false; });
 }
 
-// Two faults on one corner, the first a load-cell drift: each named rightly in its window (the
-// drift only with the rule), nothing else raised.
-void expect_the_drift_named_only_with_the_rule(const std::string& file, const char* rule,
-                                               const std::function<void(MonitorParams&)>& without) {
+// Two faults on one corner: each named rightly in its window (fault `k` of the file only with the
+// rule), nothing else raised.
+void expect_both_named_fault_k_only_with_the_rule(const std::string& file, std::size_t k, const char* rule,
+                                                  const std::function<void(MonitorParams&)>& without) {
   const auto fs = load(file);
   const auto r = run_closed_loop(fs, default_options());
   ASSERT_EQ(r.outcomes.size(), 2u);
@@ -684,26 +684,26 @@ void expect_the_drift_named_only_with_the_rule(const std::string& file, const ch
   without(opts.monitor);
   const auto base = run_closed_loop(fs, opts);
   ASSERT_EQ(base.outcomes.size(), 2u);
-  EXPECT_FALSE(base.outcomes[0].detected);  // the drift
-  EXPECT_TRUE(base.outcomes[1].detected);   // the actuator
-  std::printf("drift with %s: named after %.0f ms; without: %s after %.0f ms (window %.0f ms)\n", rule,
-              r.outcomes[0].latency_ms, to_string(base.outcomes[0].diagnosis), base.outcomes[0].diagnosis_latency_ms,
-              1e3 * detection_window_s(fs.faults.faults[0]));
+  EXPECT_FALSE(base.outcomes[k].detected);
+  EXPECT_TRUE(base.outcomes[1 - k].detected);
+  std::printf("%s with %s: named after %.0f ms; without: %s after %.0f ms (window %.0f ms)\n", to_string(r.outcomes[k].fault.type),
+              rule, r.outcomes[k].latency_ms, to_string(base.outcomes[k].diagnosis), base.outcomes[k].diagnosis_latency_ms,
+              1e3 * detection_window_s(fs.faults.faults[k]));
 }
 
 // A load-cell drift, then the actuator lost and released: the pads below the trusted range, the
 // load cell below 0 by more than the keys can pull it (stress seed 1406 run 161).
 TEST(ClosedLoopIssue14, ADriftBelowZeroOnAReleasedCaliperIsNamedByTheLowerBound) {
-  expect_the_drift_named_only_with_the_rule("config/scenarios/faults/load_cell_drift_then_a_total_loss_released.yaml",
-                                            "the lower bound below the trusted range",
+  expect_both_named_fault_k_only_with_the_rule("config/scenarios/faults/load_cell_drift_then_a_total_loss_released.yaml", 0,
+                                               "the lower bound below the trusted range",
                                             [](MonitorParams& m) { m.residual_low_lower_bound = false; });
 }
 
 // A load-cell drift on a drive seized at the pads' contact, below the trusted range: nothing
 // moves, so the load cell's level may not change (tuning seed 1401 run 57).
 TEST(ClosedLoopIssue14, ADriftOnACaliperSeizedBelowTheTrustedRangeIsNamedByTheStillDriveRule) {
-  expect_the_drift_named_only_with_the_rule("config/scenarios/faults/load_cell_drift_on_a_seized_caliper_at_the_pads.yaml",
-                                            "the still-drive rule below the trusted range",
+  expect_both_named_fault_k_only_with_the_rule("config/scenarios/faults/load_cell_drift_on_a_seized_caliper_at_the_pads.yaml", 0,
+                                               "the still-drive rule below the trusted range",
                                             [](MonitorParams& m) { m.residual_low_static_span_rev = 0.0; });
 }
 
@@ -714,6 +714,23 @@ TEST(ClosedLoopIssue14, ATotalLossWhileApplyingAtSpeedIsNamedByTheBrakingRule) {
   expect_named_in_window_only_with_the_rule("config/scenarios/faults/total_loss_while_applying_at_speed.yaml",
                                             "the lost rule while braking at speed",
                                             [](MonitorParams& m) { m.torque_lost_braking = false; });
+}
+
+// A total loss 0.1 s after a resolver offset on the same corner (tuning seed 1403 run 780): the
+// torque rules go on with the resolver's speed and its position less the offset.
+TEST(ClosedLoopIssue14, ATotalLossAfterAResolverOffsetIsNamedByTheTorqueRules) {
+  expect_both_named_fault_k_only_with_the_rule("config/scenarios/faults/resolver_offset_then_a_total_loss.yaml", 1,
+                                               "the torque rules after a resolver offset",
+                                               [](MonitorParams& m) { m.torque_after_resolver_offset = false; });
+}
+
+// A drive seized while it holds 35 kN, after a resolver offset (tuning seed 1403 run 360): its
+// current winds up past 6.5 A, where the tests' lagging - half no longer crossed 0 on average;
+// recognised by each half's extreme sample, the unanswered tests name it lost in its window.
+TEST(ClosedLoopIssue14, ADriveSeizedAtAHighHoldCurrentIsNamedByItsUnansweredTests) {
+  expect_both_named_fault_k_only_with_the_rule("config/scenarios/faults/resolver_offset_then_a_drive_seized_in_a_hard_stop.yaml", 0,
+                                               "the tests recognised by their extreme samples",
+                                               [](MonitorParams& m) { m.test_pulse_crossing_extremes = false; });
 }
 
 // The end-of-line friction model follows the position while the load cell gives no value: the

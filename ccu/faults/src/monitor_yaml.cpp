@@ -127,6 +127,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.test_pulse_unanswered = static_cast<int>(t.integer("test_pulse_unanswered", 1, 1000));
   p.test_pulse_within_s = t.number("test_pulse_within_s", pos);
   p.test_pulse_lost_mean_ratio = t.number("test_pulse_lost_mean_ratio", Range{0.0, 1.0, true, true});
+  p.test_pulse_crossing_extremes = t.boolean("test_pulse_crossing_extremes");
   p.test_pulse_weak_count = static_cast<int>(t.integer("test_pulse_weak_count", 0, TorqueDetector::kMaxWeakCount));
   p.test_pulse_weak_fraction = t.number("test_pulse_weak_fraction", Range{0.0, 1.0, true, true});
   p.test_pulse_healthy_ratio = t.number("test_pulse_healthy_ratio", Range{0.0, 2.0, true, false});
@@ -137,6 +138,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.torque_loss_rescales_drive = t.boolean("loss_rescales_drive");
   p.torque_lost_unmeasured_load_high = t.boolean("lost_unmeasured_load_high");
   p.torque_lost_braking = t.boolean("lost_braking");
+  p.torque_after_resolver_offset = t.boolean("after_resolver_offset");
   p.unexplained_margin_Nm = t.number("unexplained_margin_Nm", pos);
   p.unexplained_relative = t.number("unexplained_relative", Range::closed(0.0, 10.0));
   p.unexplained_max_speed_rev_per_s = t.number("unexplained_max_speed_rev_per_s", pos);

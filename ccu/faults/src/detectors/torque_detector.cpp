@@ -11,8 +11,8 @@ TorqueDetector::TorqueDetector(const MonitorParams& p) {
   if (p.eol_curve) eol_.emplace(*p.eol_curve);
 }
 
-void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_cell_load, const MonitorParams& p,
-                            DiagnosisArbiter& a) {
+void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_cell_load, bool position_known,
+                            const MonitorParams& p, DiagnosisArbiter& a) {
   const CornerReading& r = c.r;
   const double t = r.time_s;
   pulse_samples_ = 0;
@@ -20,7 +20,10 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // A frozen resolver repeats its last (noisy, so nonzero) speed exactly.
   const bool repeated = c.have_prev && r.speed_rev_per_s != 0.0 && r.speed_rev_per_s == c.prev.speed_rev_per_s;
   speed_repeats_ = repeated ? speed_repeats_ + 1 : 0;
-  if (!a.ok(Part::Resolver) || !std::isfinite(load_kN) || speed_repeats_ >= p.frozen_attribution_samples) {
+  const Diagnosis& resolver = a.diagnosis(Part::Resolver);
+  const bool speed_known = a.ok(Part::Resolver) || (p.torque_after_resolver_offset && resolver.active &&
+                                                    resolver.finding == Finding::ResolverOffset);
+  if (!speed_known || !std::isfinite(load_kN) || speed_repeats_ >= p.frozen_attribution_samples) {
     torque_init_ = torque_suspect_ = lost_suspect_ = unexplained_init_ = unexplained_suspect_ = static_init_ = false;
     reset_response();
     return;
@@ -55,7 +58,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // measured position and temperature with the key friction's width and the curve's band.
   const double accel_Nm = p.inertia_kg_m2 * kTwoPi * accel;
   double load_hi_kN = load_kN, load_lo_kN = load_kN;
-  if (eol_) {
+  if (eol_ && position_known) {
     const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
     const double eol_kN = eol_->force_kN(r.position_rev, temperature_C, 0.0);
     const double band_kN = p.eol_friction_half_width_kN + p.eol_band_kN + p.eol_relative * std::abs(eol_kN);
@@ -183,18 +186,26 @@ void TorqueDetector::update_response(const SampleContext& c, const MonitorParams
   // means are at least 1.3 test currents apart (at least 2, less the current's lag) and every +
   // sample stands 0.8 of it above every - one (a hold's own current jitters by a few tenths of an
   // A from sample to sample, the pulse rides on the loop's current of the sample before it).
-  double plus_A = 0.0, minus_A = 0.0, plus_min_A = 1e300, minus_max_A = -1e300;
+  double plus_A = 0.0, minus_A = 0.0, plus_min_A = 1e300, minus_max_A = -1e300, plus_max_A = -1e300, minus_min_A = 1e300;
   for (int k = 1; k <= m; ++k) {
     const double down = response_current_[at(m + k)], up = response_current_[at(k)];
     plus_A += up / m;
     minus_A += down / m;
     plus_min_A = std::min(plus_min_A, up);
     minus_max_A = std::max(minus_max_A, down);
+    plus_max_A = std::max(plus_max_A, up);
+    minus_min_A = std::min(minus_min_A, down);
   }
   const bool fell = response_current_[at(2 * m)] - response_current_[at(2 * m + 1)] <= -0.5 * amp_A;
   // ... and the current changes sign both ways, as the test's does (a = |I| + the test current),
-  // and a hold's own current changing within a few milliseconds hardly ever does.
-  const bool crosses = minus_A <= -0.5 * amp_A && plus_A >= 0.5 * amp_A;
+  // and a hold's own current changing within a few milliseconds hardly ever does. With
+  // test_pulse_crossing_extremes each half's extreme sample must cross, not its mean: from a hold
+  // current above about 6.5 A the current (L/R 0.67 ms) is still positive at the - half's first
+  // sample and the mean did not cross (tuning seed 1403 run 360: a drive seized at 35 kN wound
+  // its current up to 10-17 A and none of its tests was judged).
+  const bool crosses = p.test_pulse_crossing_extremes
+                           ? minus_min_A <= -0.5 * amp_A && plus_max_A >= 0.5 * amp_A
+                           : minus_A <= -0.5 * amp_A && plus_A >= 0.5 * amp_A;
   const bool square =
       fell && crosses && plus_A - minus_A >= 1.3 * amp_A && plus_min_A - minus_max_A >= 0.8 * amp_A;
   const double v0 = response_speed_[at(2 * m + 1)];

@@ -278,6 +278,11 @@ struct MonitorParams {
   // stop it (tuning seed 1403 run 158: a total loss at 25 rev/s in a hard stop's apply coasted the
   // caliper to 70 kN against -40 A and was never named).
   bool torque_lost_braking = true;
+  // The torque rules go on after a resolver is named offset: its speed is still the rotor's (an
+  // offset moves the position only), and its position, less the offset, while compensated
+  // (resolver_jump.compensate). Tuning seed 1403 run 780: a total loss 0.1 s after a resolver
+  // offset on the same corner, named only by the slower tracking rule, late.
+  bool torque_after_resolver_offset = true;
   // Unexplained torque (issue 14: a seized drive or a motor that makes no torque, at any load):
   // near standstill, the measured current's torque against what the load, the acceleration and
   // the drive's friction need. Pushing: make - need > drive.coulomb_friction_Nm + unexplained_margin_Nm
@@ -325,6 +330,9 @@ struct MonitorParams {
   double test_pulse_answer_ratio = 0.15;
   int test_pulse_unanswered = 2;
   double test_pulse_lost_mean_ratio = 0.075;
+  // A test is recognised when each half's extreme sample crosses 0 by half the test current (the
+  // halves' means before: missed every test from a hold current of about 6.5 A, the current's lag).
+  bool test_pulse_crossing_extremes = true;
   double test_pulse_within_s = 0.04;          // each unanswered pulse within this of the last judged one
   int test_pulse_weak_count = 8;              // at most TorqueDetector::kMaxWeakCount
   double test_pulse_weak_fraction = 0.65;

@@ -25,7 +25,12 @@ class TorqueDetector {
  public:
   explicit TorqueDetector(const MonitorParams& p);
   // `load_kN`: the load cell while it is trusted (`load_cell_load`), else the CCU's force estimate.
-  void update(const SampleContext& c, double load_kN, bool load_cell_load, const MonitorParams& p, DiagnosisArbiter& a);
+  // position_known: c.r's position is the caliper's (the resolver healthy, or named offset and
+  // compensated). A resolver named offset still measures the speed the rules need (with
+  // MonitorParams::torque_after_resolver_offset); without the position the load's range is the
+  // load alone.
+  void update(const SampleContext& c, double load_kN, bool load_cell_load, bool position_known, const MonitorParams& p,
+              DiagnosisArbiter& a);
   // The longest test pulse half the history holds, in samples (two halves and the samples before).
   static constexpr int kMaxPulseSamples = 7;
   static constexpr int kHistory = 2 * kMaxPulseSamples + 2;
