@@ -258,12 +258,9 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   }
   const bool load_cell_load = check.load_cell_present && arbiter_.ok(Part::LoadCell);
   const double load_kN = load_cell_load ? r.force_kN : force_estimate_kN;
-  if (compensated) {
-    const SampleContext cc{corrected, check, have_prev_, prev_, prev_lc_present_, c.dt_s};
-    torque_.update(cc, load_kN, load_cell_load, true, p_, arbiter_);
-  } else {
-    torque_.update(c, load_kN, load_cell_load, arbiter_.ok(Part::Resolver), p_, arbiter_);
-  }
+  // The torque rules judge the position the residual rules do (less a named offset's).
+  const SampleContext tc{compensated ? corrected : r, check, have_prev_, prev_, prev_lc_present_, c.dt_s};
+  torque_.update(tc, load_kN, load_cell_load, compensated || arbiter_.ok(Part::Resolver), p_, arbiter_);
   if (torque_.test_pulse_samples() > 0) step_.on_test_pulse(torque_.test_pulse_samples(), r.time_s, p_);
   // Without commutation the force no longer follows the command because of the resolver, not of
   // a second fault in the actuator.

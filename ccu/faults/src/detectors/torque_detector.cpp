@@ -86,7 +86,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // Braking at speed: a healthy drive's made torque is the need plus the friction against the
   // motion, whatever their signs. On a caliper with play the motor crosses the gap carrying none
   // of the load (the spindle's own friction holds it: tuning seed 1401 run 57, a healthy corner
-  // backing off at 29 kN): there the need is the largest the motor may not carry, the load less.
+  // backing off at 29 kN), so there the need is judged without the load.
   const bool braking = load_cell_load && p.torque_lost_braking && p.torque_check_moving_min_speed_rev_per_s > 0.0 &&
                        make_Nm_ <= -p.torque_check_min_torque_Nm &&
                        std::abs(r.speed_rev_per_s) >= p.torque_check_moving_min_speed_rev_per_s;
