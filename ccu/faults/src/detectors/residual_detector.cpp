@@ -58,8 +58,7 @@ void ResidualDetector::track_position(const CornerReading& r, const MonitorParam
   if (r.position_rev - x_min_rev_ >= sweep_rev || x_max_rev_ - r.position_rev >= sweep_rev) friction_known_ = true;
 }
 
-bool ResidualDetector::static_changed(const CornerReading& r, double temperature_C, const MonitorParams& p) {
-  const double curve_kN = eol_->force_kN(r.position_rev, temperature_C, 0.0);
+bool ResidualDetector::static_changed(const CornerReading& r, double curve_kN, const MonitorParams& p) {
   const double level_kN = r.force_kN - curve_kN;
   const bool still = std::abs(r.speed_rev_per_s) < p.hold_speed_rev_per_s &&
                      (static_count_ == 0 || std::abs(r.position_rev - static_x0_rev_) <= p.residual_low_static_span_rev);
@@ -122,19 +121,23 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // only an upper bound holds, the curve where the keys can be furthest in (the motor's position
   // plus half the play), at least 0.
   bool low_over = false;
-  if (eol_ && !above_min && p.residual_low_upper_bound && p.residual_findings && std::isfinite(r.force_kN)) {
+  const bool below = eol_ && !above_min && p.residual_findings && std::isfinite(r.force_kN);
+  if (below && p.residual_low_upper_bound) {
     const double f_hi_kN = std::max(0.0, eol_->force_kN(r.position_rev + 0.5 * p.eol_backlash_rev, temperature_C, 0.0));
     low_over = r.force_kN - f_hi_kN > eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_half_width_kN, f_hi_kN, r.speed_rev_per_s);
   }
   // From below: the clamp force is never negative, and the keys pull the reading below it by at
   // most their half-width, wherever the pads are (a negative drift on a released or fallen-back
   // caliper, tuning seed 1403 run 124: -1.6 kN at no clamp force, never named).
-  if (eol_ && !above_min && p.residual_low_lower_bound && p.residual_findings && std::isfinite(r.force_kN)) {
+  if (below && p.residual_low_lower_bound) {
     low_over = low_over ||
                -r.force_kN > eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_half_width_kN, 0.0, r.speed_rev_per_s);
   }
-  if (eol_ && !above_min && p.residual_low_static_span_rev > 0.0 && p.residual_findings && std::isfinite(r.force_kN)) {
-    low_over = static_changed(r, temperature_C, p) || low_over;
+  if (below && p.residual_low_static_span_rev > 0.0) {
+    // The curve at the motor's position: the keys' position is the motor's until the friction
+    // model's state is known.
+    const double motor_eol_kN = friction_known_ ? eol_->force_kN(r.position_rev, temperature_C, 0.0) : eol_keys_kN;
+    low_over = static_changed(r, motor_eol_kN, p) || low_over;
   } else {
     static_ref_ = false;
     static_count_ = 0;

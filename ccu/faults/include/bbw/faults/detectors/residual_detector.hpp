@@ -114,8 +114,9 @@ class ResidualDetector {
   double static_level_kN_ = 0.0;
   double static_x0_rev_ = 0.0;
   double static_curve_kN_ = 0.0;
-  // Below the trusted range: whether the load cell left the still drive's level.
-  bool static_changed(const CornerReading& r, double temperature_C, const MonitorParams& p);
+  // Below the trusted range: whether the load cell left the still drive's level (curve_kN: the
+  // end-of-line curve at the motor's position).
+  bool static_changed(const CornerReading& r, double curve_kN, const MonitorParams& p);
   // Names the channel that explains a disagreement that began at onset_s and confirms it.
   void isolate(double onset_s, double t, const MonitorParams& p, DiagnosisArbiter& a, const StuckDetector& stuck,
                const JumpDetector& jump) const;
