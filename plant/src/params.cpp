@@ -42,6 +42,7 @@ void PlantParams::validate() const {
   positive("transmission.coulomb_smoothing_rev_per_s", transmission.coulomb_smoothing_rev_per_s);
   non_negative("transmission.viscous_friction_Nm_per_rev_per_s",
                transmission.viscous_friction_Nm_per_rev_per_s);
+  in_range("transmission.retracted_stop_rev", transmission.retracted_stop_rev, -5.0, 0.0, "must be in [-5, 0]");
   finite("curve.contact_rev", curve.contact_rev);
   positive("curve.exp_coefficient_kN", curve.exp_coefficient_kN);
   positive("curve.exp_length_rev", curve.exp_length_rev);

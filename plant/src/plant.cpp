@@ -83,6 +83,11 @@ void Plant::substep(double i_cmd_A, double torque_scale, bool seized, double h_s
   // Semi-implicit Euler: speed first, then position with the new speed.
   s_.speed_rev_per_s = seized ? 0.0 : s_.speed_rev_per_s + h_s * accel_rev_s2;
   s_.motor_position_rev += h_s * s_.speed_rev_per_s;
+  // The retracted end stop: inelastic.
+  if (s_.motor_position_rev < t.retracted_stop_rev) {
+    s_.motor_position_rev = t.retracted_stop_rev;
+    s_.speed_rev_per_s = std::max(0.0, s_.speed_rev_per_s);
+  }
   const double x_prev = s_.position_rev;
   if (e_.backlash.enabled) {
     // Play operator: the spindle stays put (held by its own friction) inside the gap.

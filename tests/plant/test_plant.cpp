@@ -60,6 +60,33 @@ TEST(Plant, SensorsAreNoisyReproducibleAndQuantised) {
   EXPECT_NEAR(std::sqrt(ss / a.size()), p.sensors.load_cell_noise_kN, 0.003);
 }
 
+// A drive without torque, back-driven by a 30 kN clamp load: the spindle spins back, past the
+// released home, and stops at the retracted end stop; without the stop it ran on for tens of
+// revolutions (tuning seed 1401 run 81: -42 rev).
+TEST(Plant, ABackDrivenRotorStopsAtTheRetractedEndStop) {
+  plant::PlantParams p;
+  plant::Plant pl(p, {}, {}, 3);
+  pl.reset(6.0);
+  ASSERT_GT(pl.state().force_true_kN, 20.0);
+  double min_rev = 1e9, speed_at_min = 0.0;
+  for (int i = 0; i < 3000; ++i) {
+    pl.step({40.0, 0.0}, 1e-3);  // full current, no torque (a total loss)
+    if (pl.state().motor_position_rev < min_rev) {
+      min_rev = pl.state().motor_position_rev;
+      speed_at_min = pl.state().speed_rev_per_s;
+    }
+  }
+  // It reached the stop and never went past it; from there only the keys' friction moves it.
+  EXPECT_GE(min_rev, p.transmission.retracted_stop_rev);
+  EXPECT_NEAR(min_rev, p.transmission.retracted_stop_rev, 1e-4);
+  EXPECT_GE(speed_at_min, 0.0);
+  EXPECT_GE(pl.state().motor_position_rev, p.transmission.retracted_stop_rev);
+  EXPECT_LT(pl.state().motor_position_rev, 0.0);
+  EXPECT_LT(pl.state().force_true_kN, 0.01);
+  p.transmission.retracted_stop_rev = 0.1;  // beyond the released home
+  EXPECT_THROW(plant::Plant(p, {}, {}, 1), std::invalid_argument);
+}
+
 TEST(Plant, RejectsInvalidParameters) {
   plant::PlantParams p;
   p.transmission.gear_ratio = 0.0;

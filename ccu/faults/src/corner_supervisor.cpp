@@ -11,6 +11,8 @@ namespace {
 // (10 ms at 1 kHz: the noise must not walk the friction).
 constexpr double kFrictionShare = 0.5;
 constexpr double kLoadFilterGain = 0.1;
+// Points at which the curve estimate below the trusted range takes the cubic's least value.
+constexpr int kEnvelopeSteps = 16;
 
 // The most friction a fit can give: every element saturated (the sum of K_i Delta_i).
 double friction_amplitude_kN(const calibration::FrictionParams& f) {
@@ -50,6 +52,7 @@ CornerSupervisor::CornerSupervisor(const calibration::CalibratorConfig& calibrat
       trusted_curve_(calibrator.initial_curve) {
   view_.curve = trusted_curve_;
   view_.force_limit_kN = monitor.force_limit_kN;
+  if (monitor.eol_curve) eol_.emplace(*monitor.eol_curve);
 }
 
 void CornerSupervisor::on_link_event(LinkEvent e, double time_s) {
@@ -175,8 +178,24 @@ void CornerSupervisor::refresh_view(const CornerReading* r, const SampleCheck* c
       view_.source = EstimateSource::Calibrator;
     } else if (res_ok && (!lc_ok || !lc_present)) {
       const calibration::Curve& curve = lc_ok ? calibrator_->curve() : trusted_curve_;
-      // A clamp force is never negative; below the fitted range the cubic can be.
-      view_.force_estimate_kN = std::max(0.0, curve.force_kN(r->position_rev));
+      // A clamp force is never negative; below the fitted range the cubic can be. And it rises
+      // with the position, while a cubic fitted above the trusted range's lower end may turn up
+      // again below it (5.9 kN at the released home, tuning seed 1403 run 30: a drive released
+      // onto its end stop named not releasing): at most the cubic's least value from here to there,
+      // and with an end-of-line curve (which has the pads' contact) at most that curve here.
+      double curve_kN = curve.force_kN(r->position_rev);
+      const double lo_rev = monitor_.params().curve_min_rev;
+      if (r->position_rev < lo_rev) {
+        for (int k = 1; k <= kEnvelopeSteps; ++k) {
+          curve_kN = std::min(curve_kN, curve.force_kN(r->position_rev + (lo_rev - r->position_rev) * k / kEnvelopeSteps));
+        }
+        if (eol_) {
+          const double temperature_C =
+              std::isfinite(r->temperature_C) ? r->temperature_C : eol_->params().reference_temperature_C;
+          curve_kN = std::min(curve_kN, eol_->force_kN(r->position_rev, temperature_C, 0.0));
+        }
+      }
+      view_.force_estimate_kN = std::max(0.0, curve_kN);
       view_.source = EstimateSource::Curve;
     } else if (!res_ok && lc_ok && lc_present) {
       // Without the resolver: the load cell minus the friction frozen at the fault (within what

@@ -99,6 +99,8 @@ void MonitorParams::validate() const {
   positive("torque_check_min_torque_Nm", torque_check_min_torque_Nm);
   require(torque_lost_threshold > 0.0 && torque_lost_threshold < torque_fraction_threshold, "torque_lost_threshold",
           torque_lost_threshold, "must be in (0, torque_fraction_threshold)");
+  require(torque_lost_braking_threshold > 0.0 && torque_lost_braking_threshold <= torque_lost_threshold,
+          "torque_lost_braking_threshold", torque_lost_braking_threshold, "must be in (0, torque_lost_threshold]");
   positive("torque_lost_persist_s", torque_lost_persist_s);
   require(std::isfinite(drive.coulomb_friction_Nm) && drive.coulomb_friction_Nm >= 0.0, "drive.coulomb_friction_Nm",
           drive.coulomb_friction_Nm, "must be >= 0");

@@ -138,7 +138,9 @@ MonitorParams read_monitor_params(Reader& r) {
   p.torque_loss_rescales_drive = t.boolean("loss_rescales_drive");
   p.torque_lost_unmeasured_load_high = t.boolean("lost_unmeasured_load_high");
   p.torque_lost_braking = t.boolean("lost_braking");
+  p.torque_lost_braking_threshold = t.number("lost_braking_threshold", Range{0.0, 1.0, true, true});
   p.torque_after_resolver_offset = t.boolean("after_resolver_offset");
+  p.torque_stop_margin_rev = t.number("stop_margin_rev", config::Range::non_negative());
   p.unexplained_margin_Nm = t.number("unexplained_margin_Nm", pos);
   p.unexplained_relative = t.number("unexplained_relative", Range::closed(0.0, 10.0));
   p.unexplained_max_speed_rev_per_s = t.number("unexplained_max_speed_rev_per_s", pos);

@@ -61,6 +61,7 @@ PlantParams read_plant_params(Reader& r) {
     p.transmission.coulomb_smoothing_rev_per_s = t.number("coulomb_smoothing_rev_per_s", Range::positive());
     p.transmission.viscous_friction_Nm_per_rev_per_s =
         t.number("viscous_friction_Nm_per_rev_per_s", Range::non_negative());
+    p.transmission.retracted_stop_rev = t.number("retracted_stop_rev", Range::closed(-5.0, 0.0));
     t.finish();
   }
   {

@@ -83,16 +83,19 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // 2.0 kN of key friction; lost at 20.9 s).
   const double judged_fraction =
       !checkable || load_cell_load || !p.torque_lost_unmeasured_load_high ? fraction : std::max(fraction, need_hi_Nm_ / make_Nm_);
-  // Braking at speed: a healthy drive's made torque is the need plus the friction against the
-  // motion, whatever their signs. On a caliper with play the motor crosses the gap carrying none
-  // of the load (the spindle's own friction holds it: tuning seed 1401 run 57, a healthy corner
-  // backing off at 29 kN), so there the need is judged without the load.
+  // Braking at speed (the made torque against the motion): a healthy drive's made torque is the
+  // need plus the friction against the motion, whatever their signs. On a caliper with play the
+  // motor crosses the gap carrying none of the load (the spindle's own friction holds it: tuning
+  // seed 1401 run 57, a healthy corner backing off at 29 kN): the lost verdict takes whichever of
+  // the two needs, with the load or without, makes the drive the less lost.
   const bool braking = load_cell_load && p.torque_lost_braking && p.torque_check_moving_min_speed_rev_per_s > 0.0 &&
-                       make_Nm_ <= -p.torque_check_min_torque_Nm &&
+                       std::abs(make_Nm_) >= p.torque_check_min_torque_Nm && make_Nm_ * r.speed_rev_per_s < 0.0 &&
                        std::abs(r.speed_rev_per_s) >= p.torque_check_moving_min_speed_rev_per_s;
   const double carried_Nm = p.eol_backlash_rev > 0.0 ? std::max(0.0, load_kN) * p.Nm_per_kN : 0.0;
   const bool lost_braking =
-      braking && (need_Nm_ - carried_Nm + friction_Nm_) / make_Nm_ / motor_scale_ < p.torque_lost_threshold;
+      braking && std::max((need_Nm_ + friction_Nm_) / make_Nm_, (need_Nm_ - carried_Nm + friction_Nm_) / make_Nm_) /
+                         motor_scale_ <
+                     p.torque_lost_braking_threshold;
   if ((checkable && judged_fraction / motor_scale_ < p.torque_lost_threshold) || lost_braking) {
     if (!lost_suspect_) {
       lost_suspect_ = true;
@@ -139,7 +142,12 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   const bool pushing = push_Nm - need_hi_Nm_ > band &&
                        (need_hi_Nm_ + p.drive.coulomb_friction_Nm < p.torque_lost_threshold * push_Nm || winding_up);
   // Pulling: beyond the band plus the whole load (a gear in its backlash gap carries none of it).
-  const bool pulling = need_lo_Nm_ - pull_Nm > band + load_Nm;
+  // Not against the retracted end stop (the drive's, plant::TransmissionParams::retracted_stop_rev),
+  // which takes any pull: a healthy drive released onto it by its loop pulls with up to its
+  // current limit and does not move (tuning seed 1401 run 301, a loop releasing after a drifting
+  // load cell).
+  const bool at_stop = r.position_rev <= p.drive.retracted_stop_rev + p.torque_stop_margin_rev;
+  const bool pulling = !at_stop && need_lo_Nm_ - pull_Nm > band + load_Nm;
   if (slow && (pushing || pulling)) {
     if (!unexplained_suspect_) {
       unexplained_suspect_ = true;
@@ -211,6 +219,9 @@ void TorqueDetector::update_response(const SampleContext& c, const MonitorParams
   const double v0 = response_speed_[at(2 * m + 1)];
   if (square) pulse_samples_ = 2 * m;
   if (!square || std::abs(v0) > p.test_pulse_max_speed_rev_per_s) return;
+  // Against the retracted end stop the stop takes the - half: no answer to judge (stress seed
+  // 1406 run 362, a healthy drive released onto it by a loop on a noisy load cell).
+  if (r.position_rev <= p.drive.retracted_stop_rev + p.torque_stop_margin_rev) return;
   constexpr double kTwoPi = 6.283185307179586;
   // A free rotor's answer to the measured swing: each half's current is half the swing off the
   // middle, so each half accelerates by that much torque.

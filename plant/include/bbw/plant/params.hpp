@@ -26,6 +26,11 @@ struct TransmissionParams {
   double coulomb_friction_Nm = 0.05;            // drive friction at the spindle (smoothed sign)
   double coulomb_smoothing_rev_per_s = 0.2;     // speed at which tanh() reaches 76 % of it
   double viscous_friction_Nm_per_rev_per_s = 0.002;
+  // The retracted end stop (actuator rev; the released home is 0): the motor cannot turn the
+  // spindle back past it, and a rotor that reaches it stops there. Without it a drive that lost
+  // its torque while the load spun it back, or a loop that released after a drifting load cell,
+  // coasted or ran on tens to hundreds of revolutions (tuning seed 1401 runs 81 and 301).
+  double retracted_stop_rev = -0.8;
 };
 
 // The drive's friction torque at the spindle at `speed_rev_per_s`: smoothed Coulomb plus viscous

@@ -13,9 +13,11 @@
 #include <limits>
 #include <optional>
 
+
 #include "bbw/calibration/calibrator.hpp"
 #include "bbw/calibration/fusion.hpp"
 #include "bbw/calibration/config.hpp"
+#include "bbw/plant/clamp_curve.hpp"
 #include "bbw/corner_unit/controller.hpp"
 #include "bbw/faults/fault_monitor.hpp"
 #include "bbw/faults/last_good.hpp"
@@ -95,6 +97,7 @@ class CornerSupervisor {
   // force: it absorbs a change of the load up to its width, then the clamp force moves).
   double load_friction_kN_ = 0.0;
   double load_filtered_kN_ = std::numeric_limits<double>::quiet_NaN();
+  std::optional<plant::ClampCurve> eol_;  // the corner's end-of-line curve, when the scenario has one
   double fed_min_rev_ = std::numeric_limits<double>::infinity();   // positions the calibrator saw
   double fed_max_rev_ = -std::numeric_limits<double>::infinity();
   std::uint64_t restarts_ = 0;

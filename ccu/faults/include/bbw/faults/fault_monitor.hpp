@@ -278,11 +278,18 @@ struct MonitorParams {
   // stop it (tuning seed 1403 run 158: a total loss at 25 rev/s in a hard stop's apply coasted the
   // caliper to 70 kN against -40 A and was never named).
   bool torque_lost_braking = true;
+  // ... below this fraction: at speed the fraction leans on the drive's friction model and the
+  // inertia term, and a 74 % loss read 0.2-0.26 there (scoring seed 1402 run 1751, named lost);
+  // a motor without torque reads about 0.
+  double torque_lost_braking_threshold = 0.15;
   // The torque rules go on after a resolver is named offset: its speed is still the rotor's (an
   // offset moves the position only), and its position, less the offset, while compensated
   // (resolver_jump.compensate). Tuning seed 1403 run 780: a total loss 0.1 s after a resolver
   // offset on the same corner, named only by the slower tracking rule, late.
   bool torque_after_resolver_offset = true;
+  // Within this of the drive's retracted end stop (drive.retracted_stop_rev) a pull is not
+  // unexplained: the stop takes it.
+  double torque_stop_margin_rev = 0.02;
   // Unexplained torque (issue 14: a seized drive or a motor that makes no torque, at any load):
   // near standstill, the measured current's torque against what the load, the acceleration and
   // the drive's friction need. Pushing: make - need > drive.coulomb_friction_Nm + unexplained_margin_Nm
