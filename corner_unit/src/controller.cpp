@@ -39,6 +39,7 @@ void ControllerParams::validate() const {
   positive("force_bandwidth_rad_per_s", force_bandwidth_rad_per_s);
   non_negative("force_integral_rad_per_s2", force_integral_rad_per_s2);
   non_negative("force_integral_max_speed_error_rev_per_s", force_integral_max_speed_error_rev_per_s);
+  non_negative("force_home_margin_rev", force_home_margin_rev);
   positive("stiffness_at_zero_kN_per_rev", stiffness_at_zero_kN_per_rev);
   non_negative("stiffness_per_kN_per_rev", stiffness_per_kN_per_rev);
   non_negative("release_force_kN", release_force_kN);
@@ -196,7 +197,17 @@ ControllerOutput LocalController::update_force(double force_command_kN, const Co
   const double unclipped =
       force_rate_kN_per_s / s_.stiffness.stiffness_kN_per_rev +
       (p_.force_bandwidth_rad_per_s * e + p_.force_integral_rad_per_s2 * s_.force_integral_kN_s) / s_.stiffness.held_kN_per_rev;
-  const double v_ref = std::clamp(unclipped, -p_.max_speed_rev_per_s, p_.max_speed_rev_per_s);
+  double v_ref = std::clamp(unclipped, -p_.max_speed_rev_per_s, p_.max_speed_rev_per_s);
+  // Behind the released home (by more than force_home_margin_rev: an apply from the home starts
+  // with a few thousandths of a rev back) the force loop turns back at the position loop's rate: a loop on a
+  // feedback that reads too much (a load cell biased high, a curve estimate below its fitted
+  // range) no longer drives the actuator onto its retracted stop at full speed and winds its speed
+  // integrator there (tuning seed 1408 run 344: 0.27 s at -40 A on the stop while 1.5-4 kN was
+  // commanded, named actuator_tracking). Counts as clipped for the force integral.
+  const double limit_rev = p_.release_position_rev - p_.force_home_margin_rev;
+  if (p_.force_home_limit && in.position_rev < limit_rev) {
+    v_ref = std::max(v_ref, std::min(p_.max_speed_rev_per_s, p_.position_gain_per_s * (limit_rev - in.position_rev)));
+  }
   ControllerOutput out = speed_loop(v_ref, 0.0, in, dt_s);
   const bool clipped = v_ref != unclipped || out.saturated;
   const double push = unclipped - v_ref + (out.saturated ? out.current_command_A : 0.0);

@@ -1,5 +1,6 @@
 #include "bbw/scenario/corner_sim.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -26,6 +27,9 @@ corner_unit::ControllerParams corner_controller(const Scenario& s) {
   return c;
 }
 
+// Below this end-of-line force at the cubic's minimum the pads barely touch: the minimum is held.
+constexpr double kEolFloor_kN = 0.05;
+
 }  // namespace
 
 CornerSim::CornerSim(const Scenario& scenario, std::size_t index)
@@ -33,6 +37,7 @@ CornerSim::CornerSim(const Scenario& scenario, std::size_t index)
       plant_(corner_plant(scenario, index), scenario.corners[index].effects, scenario.corners[index].conditions,
              corner_seed(scenario.seed, index), scenario.plant_dt_s),
       controller_(corner_controller(scenario)),
+      eol_curve_(scenario.plant.curve),
       mode_(scenario.corners[index].drive.mode),
       feedback_(scenario.corners[index].drive.feedback) {
   const CornerSpec& c = scenario.corners[index];
@@ -60,6 +65,7 @@ CornerSim::CornerSim(const Scenario& scenario, std::size_t index)
   held_position_rev_ = m.position_rev;
   held_speed_rev_per_s_ = m.speed_rev_per_s;
   held_load_cell_kN_ = m.force_internal_kN;
+  held_temperature_C_ = std::isfinite(m.temperature_C) ? m.temperature_C : scenario.plant.curve.reference_temperature_C;
   sample_.position_rev = m.position_rev;
   sample_.force_internal_kN = m.force_internal_kN;
   sample_.force_external_kN = m.force_external_kN;
@@ -77,6 +83,7 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
   if (std::isfinite(m.position_rev)) held_position_rev_ = m.position_rev;
   if (std::isfinite(m.speed_rev_per_s)) held_speed_rev_per_s_ = m.speed_rev_per_s;
   if (std::isfinite(m.force_internal_kN)) held_load_cell_kN_ = m.force_internal_kN;
+  if (std::isfinite(m.temperature_C)) held_temperature_C_ = m.temperature_C;
   corner_unit::ControllerInputs in;
   in.position_rev = held_position_rev_;
   in.speed_rev_per_s = held_speed_rev_per_s_;
@@ -95,7 +102,7 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
     corner_unit::ForceSources src;
     src.load_cell_kN = held_load_cell_kN_;
     src.friction_estimate_kN = ext.friction_estimate_kN;
-    src.curve_estimate_kN = ext.curve ? ext.curve->force_kN(held_position_rev_) : held_load_cell_kN_;
+    src.curve_estimate_kN = ext.curve ? curve_estimate_kN(*ext.curve) : held_load_cell_kN_;
     src.true_kN = plant_.state().force_true_kN;
     const auto fb = ext.feedback ? *ext.feedback
                     : mode_ == DriveMode::Position ? corner_unit::ForceFeedback::LoadCell
@@ -125,6 +132,28 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
   sample_.friction_true_kN = s.friction_kN;
   sample_.position_true_rev = s.position_rev;
   return sample_;
+}
+
+double CornerSim::curve_estimate_kN(const CurveEstimate& curve) const {
+  // Below the lowest position the cubic is trusted at (controller.curve_trusted_min_rev, or its
+  // local minimum if higher: below that it rises again as the drive releases) the estimate is the
+  // end-of-line curve scaled to meet the cubic there: continuous, rising with the position, 0 at
+  // the pads' contact. A cubic cannot bend to the contact: on the raw polynomial the loop read
+  // 5.4 kN at 1.6 rev (tuning seed 1403 run 646) or 2.4 kN at the released home (seed 1408 run
+  // 284) and released onto its stop, or held there, while a smaller force was commanded.
+  const double x = held_position_rev_;
+  const double x_low = std::max(curve.local_min_rev(), controller_.params().curve_trusted_min_rev);
+  if (!(x < x_low)) return curve.cubic_kN(x);
+  const double f_low_kN = curve.cubic_kN(x_low);
+  const double eol_low_kN = eol_curve_.force_kN(x_low, held_temperature_C_, 0.0);
+  if (!(f_low_kN > 0.0) || !(eol_low_kN > kEolFloor_kN)) return curve.force_kN(x);  // no contact there
+  // Behind the pads' contact the end-of-line curve is flat at 0; there the estimate goes on down
+  // at the loop's own slope at zero force, so a loop that overshot the contact still reads how
+  // far (without it, stress seed 1406 run 81 overshot to -0.6 rev and was named actuator_tracking).
+  const auto& cp = eol_curve_.params();
+  const double contact_rev = cp.contact_rev + cp.contact_shift_rev_per_C * (held_temperature_C_ - cp.reference_temperature_C);
+  return f_low_kN * eol_curve_.force_kN(x, held_temperature_C_, 0.0) / eol_low_kN -
+         controller_.params().stiffness_at_zero_kN_per_rev * std::max(0.0, contact_rev - x);
 }
 
 void CornerSim::start_at(double time_s) {

@@ -751,19 +751,24 @@ TEST(ClosedLoopIssue14, ATotalLossDuringALinkSilenceIsNamedAgainstTheEndStop) {
               to_string(base.outcomes[1].diagnosis));
 }
 
-// A loop on a noisy load cell releases the healthy drive onto the end stop and pulls there: the
-// stop takes the pull and the tests' - half, and only the load cell is named (stress seed 1406 run
-// 362). Without the stop's allowance (torque.stop_margin_rev) the healthy drive was named lost.
+// A loop on a noisy load cell released the healthy drive onto the end stop and pulled there
+// (stress seed 1406 run 362): the stop takes the pull and the tests' - half, and without the
+// monitor's allowance for the stop (torque.stop_margin_rev) the healthy drive was named lost. With
+// the eighteenth session's corner (its curve estimate below the trusted range, its home limit)
+// the same scenario no longer pulls on the stop, with or without the limit: only the load cell is
+// named either way, and this test no longer shows the allowance's effect (docs/faults.md).
 TEST(ClosedLoopIssue14, AHealthyDriveReleasedOntoTheEndStopIsNotNamed) {
-  const auto fs = load("config/scenarios/faults/load_cell_noise_released_onto_the_end_stop.yaml");
+  auto fs = load("config/scenarios/faults/load_cell_noise_released_onto_the_end_stop.yaml");
   const auto r = run_closed_loop(fs, default_options());
   ASSERT_EQ(r.outcomes.size(), 1u);
   EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << to_string(r.outcomes[0].diagnosis);
   EXPECT_EQ(r.faults_raised(), 1u);
-  auto opts = default_options();
-  opts.monitor.torque_stop_margin_rev = -1.0;  // never at the stop
-  const auto base = run_closed_loop(fs, opts);
-  EXPECT_EQ(base.faults_raised(), 2u);
+  auto never_at_the_stop = default_options();
+  never_at_the_stop.monitor.torque_stop_margin_rev = -1.0;
+  EXPECT_EQ(run_closed_loop(fs, never_at_the_stop).faults_raised(), 1u);
+  fs.scenario.controller.force_home_limit = false;
+  EXPECT_EQ(run_closed_loop(fs, default_options()).faults_raised(), 1u);
+  EXPECT_EQ(run_closed_loop(fs, never_at_the_stop).faults_raised(), 1u);
   // The curve estimate below the trusted range: a drive on its curve after a dropout, released
   // onto the stop, is not named (tuning seed 1403 run 30: the cubic read 5.9 kN at the home).
   const auto d = run_closed_loop(load("config/scenarios/faults/load_cell_dropout_released_onto_the_end_stop.yaml"),
@@ -823,4 +828,50 @@ TEST(ClosedLoopIssue14, AReleaseOnTheCurveAfterALoadCellFindingStopsAtThePadsWit
   ASSERT_TRUE(fr(wound).present);
   std::printf("brake off while >= 2 kN commanded: %.0f ms; with the integral learning regardless %.0f ms and %s at %.3f s\n",
               1e3 * off_s(r), 1e3 * off_s(wound), to_string(fr(wound).finding), fr(wound).detected_s);
+}
+
+// A 62 % torque loss named, then a stuck load cell on the same corner (tuning seed 1401 run 334):
+// in the hold that follows, the tests answer about 0.26 with a whole drive's noise; judged against
+// the motor that is left, no two in a row look dead. Judged as a whole drive's, the drive was named
+// lost 3 s later (the actuator's diagnosis upgraded from the torque loss).
+TEST(ClosedLoopIssue14, AfterANamedTorqueLossTheTestsJudgeTheMotorThatIsLeft) {
+  const auto fs = load("config/scenarios/faults/torque_loss_then_a_stuck_load_cell_in_a_hold.yaml");
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 2u);
+  for (const auto& o : r.outcomes) EXPECT_TRUE(o.detected) << to_string(o.fault.type) << " " << to_string(o.diagnosis);
+  EXPECT_EQ(r.faults_raised(), 2u);
+  auto opts = default_options();
+  opts.monitor.test_pulse_rescaled_after_loss = false;
+  const auto base = run_closed_loop(fs, opts);
+  const auto named_lost = [](const LoopResult& x) {
+    for (const auto& d : x.diagnoses) {
+      if (d.present && d.finding == Finding::ActuatorLost) return true;
+    }
+    return false;
+  };
+  EXPECT_FALSE(named_lost(r));
+  EXPECT_TRUE(named_lost(base));  // RR's torque loss upgraded to actuator_lost
+}
+
+// A resolver stuck in a 37 kN hard stop (tuning seed 1403 run 420): the clamp back-drives the
+// screw onto the retracted stop unseen, and the load cell's rise toward 0 at the stop (the
+// spindle's friction vanishing, the pads off) is not named an offset while the resolver is named
+// stuck. Judged as any step, it was.
+TEST(ClosedLoopIssue14, TheMovingStepRuleLetsTheFrictionVanishWhileTheResolverIsNamedStuck) {
+  const auto fs = load("config/scenarios/faults/resolver_stuck_released_onto_the_end_stop.yaml");
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << to_string(r.outcomes[0].diagnosis);
+  EXPECT_EQ(r.faults_raised(), 1u);
+  auto opts = default_options();
+  opts.monitor.step_moving_resolver_stuck_pads_off = true;
+  const auto base = run_closed_loop(fs, opts);
+  EXPECT_EQ(base.faults_raised(), 2u);  // + load_cell_offset on FR
+  // A bias on the disc while the resolver is stuck is still a step the rule names, in 6 ms
+  // (tuning seed 1403 run 624).
+  const auto b = run_closed_loop(load("config/scenarios/faults/resolver_stuck_then_a_load_cell_bias_in_a_hard_stop.yaml"),
+                                 default_options());
+  ASSERT_EQ(b.outcomes.size(), 2u);
+  for (const auto& o : b.outcomes) EXPECT_TRUE(o.detected) << to_string(o.fault.type) << " " << to_string(o.diagnosis);
+  EXPECT_EQ(b.faults_raised(), 2u);
 }

@@ -59,7 +59,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(torque_persist_s);
   SAME(torque_lost_threshold); SAME(torque_lost_persist_s); SAME(torque_loss_rescales_drive); SAME(torque_lost_unmeasured_load_high); SAME(torque_lost_braking); SAME(torque_lost_braking_threshold); SAME(torque_after_resolver_offset); SAME(torque_stop_margin_rev);
   SAME(test_pulse_max_speed_rev_per_s); SAME(test_pulse_answer_ratio); SAME(test_pulse_unanswered); SAME(test_pulse_within_s);
-  SAME(test_pulse_lost_mean_ratio); SAME(test_pulse_crossing_extremes); SAME(test_pulse_weak_count); SAME(test_pulse_weak_fraction);
+  SAME(test_pulse_lost_mean_ratio); SAME(test_pulse_crossing_extremes); SAME(test_pulse_rescaled_after_loss); SAME(test_pulse_weak_count); SAME(test_pulse_weak_fraction);
   SAME(test_pulse_healthy_ratio); SAME(test_pulse_learn_count);
   SAME(tracking_time_constant_s); SAME(tracking_threshold_kN); SAME(tracking_relative); SAME(tracking_persist_s);
   SAME(force_limit_kN); SAME(release_min_speed_rev_per_s); SAME(deadline_s);
@@ -68,7 +68,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(hold_calibrated); SAME(hold_rebase);
   SAME(stuck_frozen_samples); SAME(stuck_frozen_run_factor); SAME(stuck_resolver_clear_samples);
   SAME(step_still_samples); SAME(step_still_span_rev); SAME(step_min_position_changes); SAME(step_kN); SAME(step_keep_fraction);
-  SAME(step_confirm_samples); SAME(step_moving); SAME(step_moving_window_samples); SAME(step_moving_quiet_fraction);
+  SAME(step_confirm_samples); SAME(step_moving); SAME(step_moving_resolver_stuck_pads_off); SAME(step_moving_window_samples); SAME(step_moving_quiet_fraction);
   SAME(step_moving_unexplained_rev); SAME(step_moving_speed_kN_per_rev_per_s);
   SAME(noise_second_difference_kN); SAME(noise_learned_factor); SAME(noise_learn_time_constant_s);
   SAME(unexplained_margin_Nm); SAME(unexplained_relative); SAME(unexplained_max_speed_rev_per_s); SAME(unexplained_persist_s);

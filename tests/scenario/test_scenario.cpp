@@ -6,6 +6,7 @@
 #include <fstream>
 #include <string>
 
+#include "bbw/plant/clamp_curve.hpp"
 #include "bbw/plant/params_yaml.hpp"
 #include "bbw/scenario/corner_sim.hpp"
 #include "bbw/scenario/load.hpp"
@@ -321,4 +322,119 @@ TEST(PaperRig, RecordedCurveMovesWithTemperatureByTheConfiguredAmount) {
     EXPECT_NEAR(recorded, configured, 0.1) << "x = " << x;
     EXPECT_GT(recorded, 1.0);
   }
+}
+
+// The force loop's curve estimate never rises as the position falls: below the cubic's local
+// minimum it is held at that minimum; above it, it is the cubic.
+TEST(CurveEstimate, HeldAtTheCubicsLocalMinimumBelowIt) {
+  // 0.2 (x - 1)^3 + 0.8 (x - 1)^2 + 2 (x - 1) + 1 has no minimum: monotone already. Stretch it:
+  // a cubic fitted on [1, 6] with a minimum at x = 0.5 (slope 3a x^2 + 2b x + c = 0).
+  const scenario::CurveEstimate none{0.2, 0.0, 2.0, 1.0};
+  EXPECT_EQ(none.local_min_rev(), -std::numeric_limits<double>::infinity());
+  EXPECT_DOUBLE_EQ(none.force_kN(-0.7), none.cubic_kN(-0.7));
+  const double a = 0.1, b = 0.9, x_m = 0.5;
+  const double c = -(3.0 * a * x_m * x_m + 2.0 * b * x_m);  // slope 0 at x_m, rising after
+  const scenario::CurveEstimate rising_below{a, b, c, 0.3};
+  EXPECT_NEAR(rising_below.local_min_rev(), x_m, 1e-12);
+  EXPECT_GT(rising_below.cubic_kN(-0.8), rising_below.cubic_kN(x_m) + 0.5);  // the raw cubic rises
+  double prev = -std::numeric_limits<double>::infinity();
+  for (double x = -0.8; x <= 6.0; x += 0.01) {
+    const double f = rising_below.force_kN(x);
+    EXPECT_GE(f, prev - 1e-12) << x;  // rounding at the minimum
+    prev = f;
+    if (x >= x_m) {
+      EXPECT_DOUBLE_EQ(f, rising_below.cubic_kN(x)) << x;
+    }
+  }
+  // A quadratic (a = 0) with its minimum at -c / 2b, and a concave one without.
+  EXPECT_DOUBLE_EQ((scenario::CurveEstimate{0.0, 1.0, -2.0, 0.0}.local_min_rev()), 1.0);
+  EXPECT_EQ((scenario::CurveEstimate{0.0, -1.0, 2.0, 0.0}.local_min_rev()), -std::numeric_limits<double>::infinity());
+  // a < 0: the minimum is the smaller stationary point.
+  const scenario::CurveEstimate falling_cubic{-0.1, 0.9, -0.6, 0.0};
+  const double xm = falling_cubic.local_min_rev();
+  EXPECT_NEAR(3 * -0.1 * xm * xm + 2 * 0.9 * xm - 0.6, 0.0, 1e-12);
+  EXPECT_GT(6 * -0.1 * xm + 2 * 0.9, 0.0);
+}
+
+// A corner on curve feedback, started released below the curve's minimum where the raw cubic
+// reads more than the command: it applies to the command instead of releasing onto its stop;
+// below the cubic's least value it finds the command on the end-of-line curve scaled to meet
+// the cubic there (this scenario's caliper is its own end-of-line caliper).
+TEST(CornerSim, CurveFeedbackBelowTheCubicsMinimumFollowsTheEndOfLineCurve) {
+  const auto s = scenario::load_scenario(source_dir() + "/config/scenarios/vehicle_stop.yaml");
+  scenario::CornerSim sim(s, 0);  // a demand drive: starts released, at 0 rev
+  ASSERT_NEAR(sim.last().position_true_rev, 0.0, 1e-9);
+  const plant::ClampCurve eol(s.plant.curve);
+  const double temperature_C = s.corners[0].conditions.temperature_C;
+  // A cubic with its minimum at 1.6 rev, 10 % above the end-of-line curve there (as tuning seed
+  // 1403 run 646's), rising to 12 kN at the released home: on the raw cubic any command below
+  // 12 kN reads as too much force at 0 rev.
+  const double a = 0.4, b = 1.2, x_m = 1.6, scale = 1.1;
+  const double c = -(3.0 * a * x_m * x_m + 2.0 * b * x_m);
+  const double d = scale * eol.force_kN(x_m, temperature_C, 0.0) - ((a * x_m + b) * x_m + c) * x_m;
+  scenario::ExternalInputs ext;
+  ext.curve = scenario::CurveEstimate{a, b, c, d};
+  ASSERT_GT(ext.curve->cubic_kN(0.0), 10.0);
+  ext.feedback = corner_unit::ForceFeedback::Curve;
+  ext.force_command_kN = 8.0;
+  for (int i = 0; i < 2000; ++i) sim.step(s.plant_dt_s, ext);
+  EXPECT_GT(sim.last().position_true_rev, x_m);
+  EXPECT_NEAR(ext.curve->cubic_kN(sim.last().position_rev), 8.0, 0.3);
+  // A command below the cubic's least value (4.1 kN): found on the scaled end-of-line curve.
+  ext.force_command_kN = 2.5;
+  for (int i = 0; i < 2000; ++i) sim.step(s.plant_dt_s, ext);
+  EXPECT_GT(sim.last().position_true_rev, s.plant.curve.contact_rev);
+  EXPECT_LT(sim.last().position_true_rev, x_m);
+  EXPECT_NEAR(sim.last().force_true_kN, 2.5 / scale, 0.3);
+}
+
+// A force loop whose feedback reads more than any command (a load cell 6 kN high) releases to
+// the released home and stays there (controller.force_home_limit); without the limit it drove
+// the actuator onto the plant's retracted stop and pushed there at the current limit.
+TEST(CornerSim, AForceLoopReadingTooMuchStopsAtTheReleasedHome) {
+  struct High : scenario::SensorHook {
+    void apply(plant::Measurement& m) override { m.force_internal_kN += 6.0; }
+  };
+  auto s = scenario::load_scenario(source_dir() + "/config/scenarios/vehicle_stop.yaml");
+  const auto run = [&](bool limit) {
+    s.controller.force_home_limit = limit;
+    scenario::CornerSim sim(s, 0);
+    High high;
+    scenario::ExternalInputs ext;
+    ext.sensor_hook = &high;
+    ext.feedback = corner_unit::ForceFeedback::LoadCell;
+    ext.force_command_kN = 2.0;
+    double lowest_rev = 0.0, last_A = 0.0;
+    for (int i = 0; i < 1000; ++i) {
+      const auto& k = sim.step(s.plant_dt_s, ext);
+      lowest_rev = std::min(lowest_rev, k.position_true_rev);
+      last_A = k.current_command_A;
+    }
+    return std::pair{lowest_rev, last_A};
+  };
+  const auto [limited_rev, limited_A] = run(true);
+  EXPECT_GT(limited_rev, s.controller.release_position_rev - s.controller.force_home_margin_rev - 0.05);
+  EXPECT_LT(std::abs(limited_A), 5.0);
+  const auto [free_rev, free_A] = run(false);
+  EXPECT_NEAR(free_rev, s.plant.transmission.retracted_stop_rev, 1e-6);
+  EXPECT_LT(free_A, -30.0);
+}
+
+// A cubic without a local minimum that reads 2 kN at the released home (a line, 2 + 3 x): below
+// controller.curve_trusted_min_rev (1 rev) the end-of-line curve scaled to meet it takes over, and
+// a 1 kN command puts the pads on the disc. On the raw line the loop looked for 1 kN behind the
+// home, with the pads off.
+TEST(CornerSim, CurveFeedbackBelowTheTrustedPositionFollowsTheEndOfLineCurve) {
+  const auto s = scenario::load_scenario(source_dir() + "/config/scenarios/vehicle_stop.yaml");
+  ASSERT_DOUBLE_EQ(s.controller.curve_trusted_min_rev, 1.0);
+  scenario::CornerSim sim(s, 0);
+  scenario::ExternalInputs ext;
+  ext.curve = scenario::CurveEstimate{0.0, 0.0, 3.0, 2.0};
+  ASSERT_EQ(ext.curve->local_min_rev(), -std::numeric_limits<double>::infinity());
+  ext.feedback = corner_unit::ForceFeedback::Curve;
+  ext.force_command_kN = 1.0;
+  for (int i = 0; i < 2000; ++i) sim.step(s.plant_dt_s, ext);
+  EXPECT_GT(sim.last().position_true_rev, s.plant.curve.contact_rev);
+  EXPECT_GT(sim.last().force_true_kN, 0.1);
+  EXPECT_LT(sim.last().force_true_kN, 1.0);
 }

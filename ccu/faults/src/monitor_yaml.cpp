@@ -95,6 +95,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.step_moving_quiet_fraction = mv.number("quiet_fraction", pos);
     p.step_moving_unexplained_rev = mv.number("unexplained_position_rev", pos);
     p.step_moving_speed_kN_per_rev_per_s = mv.number("speed_kN_per_rev_per_s", config::Range::non_negative());
+    p.step_moving_resolver_stuck_pads_off = mv.boolean("resolver_stuck_pads_off");
     mv.finish();
   }
   st.finish();
@@ -128,6 +129,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.test_pulse_within_s = t.number("test_pulse_within_s", pos);
   p.test_pulse_lost_mean_ratio = t.number("test_pulse_lost_mean_ratio", Range{0.0, 1.0, true, true});
   p.test_pulse_crossing_extremes = t.boolean("test_pulse_crossing_extremes");
+  p.test_pulse_rescaled_after_loss = t.boolean("test_pulse_rescaled_after_loss");
   p.test_pulse_weak_count = static_cast<int>(t.integer("test_pulse_weak_count", 0, TorqueDetector::kMaxWeakCount));
   p.test_pulse_weak_fraction = t.number("test_pulse_weak_fraction", Range{0.0, 1.0, true, true});
   p.test_pulse_healthy_ratio = t.number("test_pulse_healthy_ratio", Range{0.0, 2.0, true, false});

@@ -44,6 +44,15 @@ struct ControllerParams {
   double stiffness_per_kN_per_rev = 0.3;       // (kN/rev) per kN
   double release_force_kN = 0.1;
   double release_position_rev = 0.0;
+  // In force mode, behind release_position_rev - force_home_margin_rev the speed reference is at
+  // least position_gain_per_s x the distance back to it: the force loop never drives the actuator
+  // onto its retracted stop.
+  bool force_home_limit = true;
+  double force_home_margin_rev = 0.1;
+  // Curve feedback (the CCU's calibrated cubic): below this position, or below the cubic's local
+  // minimum if that is higher, the estimate is the end-of-line curve scaled to meet the cubic
+  // there (a cubic cannot bend to the pads' contact; the CCU's monitor trusts it from 1 rev up).
+  double curve_trusted_min_rev = 1.0;
   bool load_feedforward = true;
   // The force loop's stiffness seen in its own feedback (k_seen above). An increment of the
   // regression closes when the position has moved stride_rev or the feedback stride_kN since the

@@ -3,6 +3,7 @@
 // numbers for the same scenario, corner and inputs. Pure: time advances only through step().
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -10,6 +11,7 @@
 #include <string>
 
 #include "bbw/corner_unit/controller.hpp"
+#include "bbw/plant/clamp_curve.hpp"
 #include "bbw/plant/plant.hpp"
 #include "bbw/scenario/profile.hpp"
 #include "bbw/scenario/scenario.hpp"
@@ -35,9 +37,25 @@ struct CornerSample : plant::Measurement {
 };
 
 // A curve estimate from the calibrator: F = ((A x + B) x + C) x + D, kN with x in rev.
+// A force loop's curve estimate: the calibrated cubic, held at its least value below its local
+// minimum. A cubic fitted over the caliper's range rises again below that minimum (the released
+// end, where it was never fitted); a loop on the raw polynomial there read more force the further
+// it released, released the more and ran a healthy drive back onto its retracted stop while
+// force was commanded. Held, the estimate never rises as the position falls.
 struct CurveEstimate {
   double a = 0.0, b = 0.0, c = 0.0, d = 0.0;
-  double force_kN(double x_rev) const { return ((a * x_rev + b) * x_rev + c) * x_rev + d; }
+  double cubic_kN(double x_rev) const { return ((a * x_rev + b) * x_rev + c) * x_rev + d; }
+  // The cubic's local minimum (where its slope 3a x^2 + 2b x + c is 0 and rising), or -inf.
+  double local_min_rev() const {
+    if (a == 0.0) return b > 0.0 ? -c / (2.0 * b) : -std::numeric_limits<double>::infinity();
+    const double disc = b * b - 3.0 * a * c;
+    if (!(disc > 0.0)) return -std::numeric_limits<double>::infinity();
+    return (-b + std::sqrt(disc)) / (3.0 * a);
+  }
+  double force_kN(double x_rev) const {
+    const double x_min = local_min_rev();
+    return cubic_kN(x_rev < x_min ? x_min : x_rev);
+  }
 };
 
 // A hook between the sensors and everything that reads them (fault injection, docs/faults.md):
@@ -97,9 +115,15 @@ class CornerSim {
   corner_unit::ForceFeedback feedback() const { return feedback_; }
 
  private:
+  // The curve feedback's estimate at the held position (see eol_curve_).
+  double curve_estimate_kN(const CurveEstimate& curve) const;
+
   std::string name_;
   plant::Plant plant_;
   corner_unit::LocalController controller_;
+  // The caliper's end-of-line curve (its production-line measurement, the same the CCU's monitor
+  // holds): the curve feedback's estimate below the calibrated cubic's minimum.
+  plant::ClampCurve eol_curve_;
   DriveMode mode_;
   corner_unit::ForceFeedback feedback_;
   std::optional<PositionProfile> position_profile_;
@@ -111,6 +135,7 @@ class CornerSim {
   double held_position_rev_ = 0.0;  // last finite readings, for the local controller
   double held_speed_rev_per_s_ = 0.0;
   double held_load_cell_kN_ = 0.0;
+  double held_temperature_C_ = 0.0;
   CornerSample sample_;
 };
 

@@ -202,6 +202,10 @@ struct MonitorParams {
   double step_moving_quiet_fraction = 0.25;
   double step_moving_unexplained_rev = 0.003;
   double step_moving_speed_kN_per_rev_per_s = 0.3;
+  // The moving rule judges also a rise toward 0 from below it (not past it by more than step_kN)
+  // while the resolver is named stuck (false: not judged; the pads are off, and the spindle's
+  // friction vanishes when the drive's unseen motion stops).
+  bool step_moving_resolver_stuck_pads_off = false;
 
   // Noise: in a window of the residual's sample-to-sample changes, the share larger than
   // noise_step_kN (a single step, e.g. a bias or a resolver jump, is one sample, not noise).
@@ -340,6 +344,9 @@ struct MonitorParams {
   // A test is recognised when each half's extreme sample crosses 0 by half the test current (the
   // halves' means before: missed every test from a hold current of about 6.5 A, the current's lag).
   bool test_pulse_crossing_extremes = true;
+  // After a named torque loss (torque_loss_rescales_drive) the tests' answers are judged against
+  // the motor that is left: the answer divided by the remaining fraction estimated then.
+  bool test_pulse_rescaled_after_loss = true;
   double test_pulse_within_s = 0.04;          // each unanswered pulse within this of the last judged one
   int test_pulse_weak_count = 8;              // at most TorqueDetector::kMaxWeakCount
   double test_pulse_weak_fraction = 0.65;
