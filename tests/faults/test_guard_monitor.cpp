@@ -1448,3 +1448,37 @@ TEST(FaultMonitor, CalibratedAHoldKeepsItsLevelWhileTheLearntStatisticsFollowADr
   EXPECT_LT(learnt.detected_s, window_end_s);
   EXPECT_FALSE(run(false, 0.0, running).present);
 }
+
+// The lost rules judge a drive only once its torque filters have settled (three filter time
+// constants since their first sample): at a start or a rejoin the acceleration is unknown and the
+// need starts at the load alone. A drive pulled back by its load at -4 rev/s, faster than the
+// motor's 1.4 A holding back explains (as the realtime system test
+// SystemNetns.CornerLinkDownIsDetectedAndTheCornerRejoins saw an outage's own release when the
+// link returned): named lost once settled, not in the first 35 ms.
+TEST(FaultMonitor, TheLostRulesWaitForTheirFiltersToSettle) {
+  const MonitorParams p = noiseless();
+  const SampleCheck ok;
+  auto run = [&](int settled_samples) {
+    FaultMonitor m(p, Target::FL);
+    std::uint64_t k = 0;
+    double x = 3.0;
+    for (int i = 0; i < settled_samples; ++i, ++k) {  // a hold: the current carries the load
+      auto r = at(k + 1, 0.001 * (k + 1), x, 17.5);
+      r.speed_rev_per_s = 1e-3 * static_cast<double>(k % 3);
+      r.motor_current_A = 17.5 * p.Nm_per_kN / p.torque_per_A_Nm;
+      m.update(r, ok, nullptr, 17.5, r.time_s);
+    }
+    double v = -3.7;
+    for (int i = 0; i < 35; ++i, ++k) {  // backing off faster than the held-back torque explains
+      v -= 0.043;
+      x += v * 0.001;
+      auto r = at(k + 1, 0.001 * (k + 1), x, 17.5);
+      r.speed_rev_per_s = v;
+      r.motor_current_A = 0.38 / p.torque_per_A_Nm;
+      m.update(r, ok, nullptr, 17.5, r.time_s);
+    }
+    return m.diagnosis(Part::Actuator);
+  };
+  { const auto d0 = run(0); EXPECT_FALSE(d0.present) << to_string(d0.finding) << " at " << d0.detected_s << " onset " << d0.onset_s; }
+  EXPECT_EQ(run(40).finding, Finding::ActuatorLost);
+}

@@ -346,6 +346,14 @@ TEST(CurveEstimate, HeldAtTheCubicsLocalMinimumBelowIt) {
       EXPECT_DOUBLE_EQ(f, rising_below.cubic_kN(x)) << x;
     }
   }
+  // The least value over an interval (the CCU's curve estimate below the trusted range): at an
+  // end or at the local minimum, as a fine grid finds it.
+  const bbw::model::Curve m{a, b, c, 0.3};
+  for (const auto& [lo, hi] : {std::pair{-0.8, 1.0}, std::pair{0.6, 2.0}, std::pair{-0.8, 0.2}}) {
+    double grid = std::numeric_limits<double>::infinity();
+    for (int k = 0; k <= 10000; ++k) grid = std::min(grid, m.force_kN(lo + (hi - lo) * k / 10000.0));
+    EXPECT_NEAR(m.least_kN(lo, hi), grid, 1e-6) << lo << " " << hi;
+  }
   // A quadratic (a = 0) with its minimum at -c / 2b, and a concave one without.
   EXPECT_DOUBLE_EQ((scenario::CurveEstimate{0.0, 1.0, -2.0, 0.0}.local_min_rev()), 1.0);
   EXPECT_EQ((scenario::CurveEstimate{0.0, -1.0, 2.0, 0.0}.local_min_rev()), -std::numeric_limits<double>::infinity());

@@ -11,8 +11,6 @@ namespace {
 // (10 ms at 1 kHz: the noise must not walk the friction).
 constexpr double kFrictionShare = 0.5;
 constexpr double kLoadFilterGain = 0.1;
-// Points at which the curve estimate below the trusted range takes the cubic's least value.
-constexpr int kEnvelopeSteps = 16;
 
 // The most friction a fit can give: every element saturated (the sum of K_i Delta_i).
 double friction_amplitude_kN(const calibration::FrictionParams& f) {
@@ -186,9 +184,7 @@ void CornerSupervisor::refresh_view(const CornerReading* r, const SampleCheck* c
       double curve_kN = curve.force_kN(r->position_rev);
       const double lo_rev = monitor_.params().curve_min_rev;
       if (r->position_rev < lo_rev) {
-        for (int k = 1; k <= kEnvelopeSteps; ++k) {
-          curve_kN = std::min(curve_kN, curve.force_kN(r->position_rev + (lo_rev - r->position_rev) * k / kEnvelopeSteps));
-        }
+        curve_kN = curve.least_kN(r->position_rev, lo_rev);
         if (eol_) {
           const double temperature_C =
               std::isfinite(r->temperature_C) ? r->temperature_C : eol_->params().reference_temperature_C;

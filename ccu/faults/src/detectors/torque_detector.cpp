@@ -35,6 +35,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   const double drive_friction = plant::drive_friction_Nm(p.drive, r.speed_rev_per_s);
   if (!torque_init_ || c.dt_s <= 0.0) {
     torque_init_ = true;
+    torque_since_s_ = r.time_s;
     need_Nm_ = need;
     make_Nm_ = make;
     friction_Nm_ = drive_friction;
@@ -96,7 +97,14 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
       braking && std::max((need_Nm_ + friction_Nm_) / make_Nm_, (need_Nm_ - carried_Nm + friction_Nm_) / make_Nm_) /
                          motor_scale_ <
                      p.torque_lost_braking_threshold;
-  if ((checkable && judged_fraction / motor_scale_ < p.torque_lost_threshold) || lost_braking) {
+  // The lost verdicts only once the filters have settled (kSettledTimeConstants of
+  // torque_filter_s since they started): at a rejoin the acceleration is unknown, the need starts
+  // at the load alone and lags the drive's motion (realtime system test
+  // SystemNetns.CornerLinkDownIsDetectedAndTheCornerRejoins: a healthy corner backing off at
+  // -4 rev/s in the outage's own release, seen as its link returned, was named lost 7 ms after
+  // the filters started).
+  const bool settled = r.time_s - torque_since_s_ >= kSettledTimeConstants * p.torque_filter_s;
+  if (settled && ((checkable && judged_fraction / motor_scale_ < p.torque_lost_threshold) || lost_braking)) {
     if (!lost_suspect_) {
       lost_suspect_ = true;
       lost_onset_s_ = t;

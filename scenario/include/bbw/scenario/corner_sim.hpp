@@ -11,6 +11,7 @@
 #include <string>
 
 #include "bbw/corner_unit/controller.hpp"
+#include "bbw/model/curve.hpp"
 #include "bbw/plant/clamp_curve.hpp"
 #include "bbw/plant/plant.hpp"
 #include "bbw/scenario/profile.hpp"
@@ -44,14 +45,8 @@ struct CornerSample : plant::Measurement {
 // force was commanded. Held, the estimate never rises as the position falls.
 struct CurveEstimate {
   double a = 0.0, b = 0.0, c = 0.0, d = 0.0;
-  double cubic_kN(double x_rev) const { return ((a * x_rev + b) * x_rev + c) * x_rev + d; }
-  // The cubic's local minimum (where its slope 3a x^2 + 2b x + c is 0 and rising), or -inf.
-  double local_min_rev() const {
-    if (a == 0.0) return b > 0.0 ? -c / (2.0 * b) : -std::numeric_limits<double>::infinity();
-    const double disc = b * b - 3.0 * a * c;
-    if (!(disc > 0.0)) return -std::numeric_limits<double>::infinity();
-    return (-b + std::sqrt(disc)) / (3.0 * a);
-  }
+  double cubic_kN(double x_rev) const { return model::Curve{a, b, c, d}.force_kN(x_rev); }
+  double local_min_rev() const { return model::Curve{a, b, c, d}.local_min_rev(); }
   double force_kN(double x_rev) const {
     const double x_min = local_min_rev();
     return cubic_kN(x_rev < x_min ? x_min : x_rev);

@@ -54,6 +54,8 @@ class TorqueDetector {
   bool lost_suspect_ = false;
   double lost_onset_s_ = 0.0;
   bool torque_init_ = false;
+  double torque_since_s_ = 0.0;  // when the filters below started (their first sample)
+  static constexpr double kSettledTimeConstants = 3.0;
   double need_Nm_ = 0.0;
   double make_Nm_ = 0.0;
   double friction_Nm_ = 0.0;  // filtered drive friction at the measured speed
