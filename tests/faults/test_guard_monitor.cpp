@@ -1482,3 +1482,47 @@ TEST(FaultMonitor, TheLostRulesWaitForTheirFiltersToSettle) {
   { const auto d0 = run(0); EXPECT_FALSE(d0.present) << to_string(d0.finding) << " at " << d0.detected_s << " onset " << d0.onset_s; }
   EXPECT_EQ(run(40).finding, Finding::ActuatorLost);
 }
+
+// Samples lost between two usable ones (an outage whose blocks came through one at a time, no
+// rejoin) break the torque rules' filters and persistence: a suspicion from one block is not
+// confirmed by the first sample of the next, 0.28 s later (realtime system test
+// SystemNetns.CornerLinkDownIsDetectedAndTheCornerRejoins). Without the gap it is.
+TEST(FaultMonitor, TheTorqueRulesStartAgainAfterLostSamples) {
+  const MonitorParams p = noiseless();
+  const SampleCheck ok;
+  // The transient of the test above after a settled hold, with `gap_s` before transient sample
+  // `gap_at`; returns the transient sample at which the actuator is first named (-1: never).
+  auto run = [&](int gap_at, double gap_s) {
+    FaultMonitor m(p, Target::FL);
+    std::uint64_t seq = 0;
+    double t = 0.0, x = 3.0, v = -3.7;
+    for (int i = 0; i < 40; ++i) {
+      t += 0.001;
+      auto r = at(++seq, t, x, 17.5);
+      r.speed_rev_per_s = 1e-3 * static_cast<double>(i % 3);
+      r.motor_current_A = 17.5 * p.Nm_per_kN / p.torque_per_A_Nm;
+      m.update(r, ok, nullptr, 17.5, t);
+    }
+    for (int i = 0; i < 60; ++i) {
+      const double dt = i == gap_at ? gap_s : 0.001;
+      t += dt;
+      seq += static_cast<std::uint64_t>(std::lround(dt / 0.001));
+      // After the gap the drive reverses at 40 A, as the corner did when its link came back:
+      // healthy (the acceleration carries the torque), but its first sample, with the
+      // acceleration unknown, looks lost.
+      const bool reversing = gap_at >= 0 && i >= gap_at;
+      v += reversing ? 0.57 : -0.043;
+      x += v * 0.001;
+      auto r = at(seq, t, x, reversing ? 6.6 : 17.5);
+      r.speed_rev_per_s = v;
+      r.motor_current_A = reversing ? 40.0 : 0.38 / p.torque_per_A_Nm;
+      m.update(r, ok, nullptr, r.force_kN, t);
+      if (m.diagnosis(Part::Actuator).present) return i;
+    }
+    return -1;
+  };
+  const int named_at = run(-1, 0.0);
+  ASSERT_GE(named_at, 5);
+  // The gap 3 samples before that, the suspicion 12 ms into its 15: not named at all.
+  EXPECT_EQ(run(named_at - 3, 0.28), -1);
+}

@@ -16,7 +16,14 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   const CornerReading& r = c.r;
   const double t = r.time_s;
   pulse_samples_ = 0;
-  const double accel = c.have_prev && c.dt_s > 0.0 ? (r.speed_rev_per_s - c.prev.speed_rev_per_s) / c.dt_s : 0.0;
+  // Samples lost between two usable ones (no rejoin: a corner in an outage whose blocks came
+  // through one or two at a time) break the filters, the acceleration and every persistence: they
+  // start again. Otherwise a suspicion from one block was confirmed by the first sample of the
+  // next, 0.28 s later (realtime SystemNetns.CornerLinkDownIsDetectedAndTheCornerRejoins: a
+  // healthy corner named lost as its link came back).
+  if (c.have_prev && c.dt_s > p.jump_max_gap_s) on_rejoin();
+  const bool continuous = c.have_prev && c.dt_s > 0.0 && c.dt_s <= p.jump_max_gap_s;
+  const double accel = continuous ? (r.speed_rev_per_s - c.prev.speed_rev_per_s) / c.dt_s : 0.0;
   // A frozen resolver repeats its last (noisy, so nonzero) speed exactly.
   const bool repeated = c.have_prev && r.speed_rev_per_s != 0.0 && r.speed_rev_per_s == c.prev.speed_rev_per_s;
   speed_repeats_ = repeated ? speed_repeats_ + 1 : 0;
