@@ -150,8 +150,7 @@ double CornerSim::curve_estimate_kN(const CurveEstimate& curve) const {
   // Behind the pads' contact the end-of-line curve is flat at 0; there the estimate goes on down
   // at the loop's own slope at zero force, so a loop that overshot the contact still reads how
   // far (without it, stress seed 1406 run 81 overshot to -0.6 rev and was named actuator_tracking).
-  const auto& cp = eol_curve_.params();
-  const double contact_rev = cp.contact_rev + cp.contact_shift_rev_per_C * (held_temperature_C_ - cp.reference_temperature_C);
+  const double contact_rev = eol_curve_.contact_rev(held_temperature_C_, 0.0);
   return f_low_kN * eol_curve_.force_kN(x, held_temperature_C_, 0.0) / eol_low_kN -
          controller_.params().stiffness_at_zero_kN_per_rev * std::max(0.0, contact_rev - x);
 }

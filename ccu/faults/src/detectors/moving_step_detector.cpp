@@ -69,8 +69,7 @@ void MovingStepDetector::update(const SampleContext& c, const MonitorParams& p, 
   // A position step the measured speed does not explain: the resolver's, not the load cell's.
   const bool explained = std::abs(dx - r.speed_rev_per_s * c.dt_s) <= p.step_moving_unexplained_rev;
   // Where the end-of-line curve has the pads on the disc (its contact point at this temperature).
-  const auto& cp = eol_->params();
-  const double contact_rev = cp.contact_rev + cp.contact_shift_rev_per_C * (temperature_C - cp.reference_temperature_C);
+  const double contact_rev = eol_->contact_rev(temperature_C, 0.0);
   const bool trusted = r.position_rev >= contact_rev && c.prev.position_rev >= contact_rev;
   if (!explained || !trusted) {
     reset();
