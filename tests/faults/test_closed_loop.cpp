@@ -707,6 +707,16 @@ TEST(ClosedLoopIssue14, ADriftOnACaliperSeizedBelowTheTrustedRangeIsNamedByTheSt
                                             [](MonitorParams& m) { m.residual_low_static_span_rev = 0.0; });
 }
 
+// A resolver stuck in a held hard stop, then a load-cell drift on the same corner 45 ms later
+// (tuning seed 1401 run 394): without the position no residual rule judges the load cell, and the
+// drift was never named. The motor has no current then and the drive holds the load, so the
+// clamp force cannot rise: the held level is the reference (unpowered.*).
+TEST(ClosedLoopIssue14, ADriftAfterAStuckResolverIsNamedAgainstTheUnpoweredHold) {
+  expect_both_named_fault_k_only_with_the_rule(
+      "config/scenarios/faults/load_cell_drift_after_a_stuck_resolver_in_a_hard_stop.yaml", 1,
+      "the unpowered hold", [](MonitorParams& m) { m.unpowered_hold = false; });
+}
+
 // A total loss while a hard stop applies at the speed limit: the motor brakes with -40 A and the
 // rotor coasts on (tuning seed 1403 run 158). Named lost by the braking rule in its window; never
 // without it.

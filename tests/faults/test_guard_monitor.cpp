@@ -1526,3 +1526,46 @@ TEST(FaultMonitor, TheTorqueRulesStartAgainAfterLostSamples) {
   // The gap 3 samples before that, the suspicion 12 ms into its 15: not named at all.
   EXPECT_EQ(run(named_at - 3, 0.28), -1);
 }
+
+// A resolver that freezes while its drive holds 20 kN leaves the motor without current: the
+// clamp force can stay or fall (the load drives the spindle back), never rise. So a load cell
+// that rises by more than unpowered_kN from the level it settled at names a load-cell offset
+// (issue 14, tuning seed 1401 run 394); a fall, a rotor frozen at speed (it coasts on, the force
+// rising), a current the corner still drives, or the rule off: nothing on the load cell.
+TEST(FaultMonitor, AHeldDriveWithoutCurrentCannotRaiseItsLoadCell) {
+  const MonitorParams shipped;  // the frozen-resolver rule names the resolver 20 samples in
+  const SampleCheck ok;
+  // 100 live samples, then the resolver frozen at `speed` with the motor at `current_A`; after
+  // 100 frozen samples the load cell moves by `change_kN` over 50 ms and stays there.
+  auto run = [&](double speed, double current_A, double change_kN, const MonitorParams& p) {
+    FaultMonitor m(p, Target::RL);
+    std::uint64_t seq = 0;
+    double t = 0.0;
+    for (int k = 0; k < 100; ++k) {
+      t += 0.001;
+      auto r = at(++seq, t, 4.0 + 2e-5 * (k % 3), 20.0 + 0.01 * (k % 2));
+      r.speed_rev_per_s = 1e-3 * (k % 5);
+      r.motor_current_A = 3.0;
+      m.update(r, ok, nullptr, r.force_kN, t);
+    }
+    for (int k = 0; k < 400; ++k) {
+      t += 0.001;
+      const double moved = change_kN * std::clamp((k - 100) / 50.0, 0.0, 1.0);
+      auto r = at(++seq, t, 4.0, 20.0 + 0.01 * (k % 2) + moved);
+      r.speed_rev_per_s = speed;
+      r.motor_current_A = current_A;
+      m.update(r, ok, nullptr, r.force_kN, t);
+    }
+    EXPECT_EQ(m.diagnosis(Part::Resolver).finding, Finding::ResolverStuck);
+    return m.diagnosis(Part::LoadCell);
+  };
+  const auto rise = run(0.0, 0.0, 1.0, shipped);
+  EXPECT_TRUE(rise.present);
+  EXPECT_EQ(rise.finding, Finding::LoadCellOffset);
+  EXPECT_FALSE(run(0.0, 0.0, -3.0, shipped).present);  // the load drives the spindle back
+  EXPECT_FALSE(run(20.0, 0.0, 1.0, shipped).present);  // frozen at speed: the rotor coasts on
+  EXPECT_FALSE(run(0.0, 5.0, 1.0, shipped).present);   // a current: not the corner's frozen-resolver stop
+  MonitorParams off = shipped;
+  off.unpowered_hold = false;
+  EXPECT_FALSE(run(0.0, 0.0, 1.0, off).present);
+}

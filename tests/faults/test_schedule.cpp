@@ -64,7 +64,8 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
                fs.scenario.name == "total_loss_after_a_link_silence" ||
                fs.scenario.name == "load_cell_dropout_released_onto_the_end_stop" ||
                fs.scenario.name == "torque_loss_then_a_stuck_load_cell_in_a_hold" ||
-               fs.scenario.name == "resolver_stuck_then_a_load_cell_bias_in_a_hard_stop") {  // two faults, one corner
+               fs.scenario.name == "resolver_stuck_then_a_load_cell_bias_in_a_hard_stop" ||
+               fs.scenario.name == "load_cell_drift_after_a_stuck_resolver_in_a_hard_stop") {  // two faults, one corner
       ASSERT_EQ(fs.faults.faults.size(), 2u) << entry.path();
       EXPECT_EQ(fs.faults.faults[0].target, fs.faults.faults[1].target);
       for (const auto& f : fs.faults.faults) types.insert(f.type);
@@ -73,7 +74,7 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
       types.insert(fs.faults.faults[0].type);
     }
   }
-  EXPECT_EQ(files, 37u);  // actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four
+  EXPECT_EQ(files, 38u);  // actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four
                           // times: in a hold, while applying, before the first fit, in a hard stop released on the
                           // curve; load_cell drift four times: in a stop, followed by the loop in a hard stop,
                           // while the brake modulates, below the trusted range; load_cell dropout twice: in a
@@ -84,7 +85,7 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
                           // on one corner; a total loss after a link silence; a load cell's noise and a dropout,
                           // each released onto the end stop; a torque loss then a stuck load cell on one
                           // corner; a resolver stuck in a hard stop, released onto the end stop, and then
-                          // a load-cell bias on its corner
+                          // a load-cell bias on its corner, or a load-cell drift on it
   EXPECT_EQ(standby_files, 4u);  // ccu_failover_{kill,hang,link_cut,both_lost}
   EXPECT_EQ(types.size(), 14u);  // every FaultType; stuck appears for both sensors
 }

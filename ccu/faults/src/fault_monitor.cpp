@@ -74,6 +74,13 @@ void MonitorParams::validate() const {
   positive("step_moving_unexplained_rev", step_moving_unexplained_rev);
   require(std::isfinite(step_moving_speed_kN_per_rev_per_s) && step_moving_speed_kN_per_rev_per_s >= 0.0,
           "step_moving_speed_kN_per_rev_per_s", step_moving_speed_kN_per_rev_per_s, "must be >= 0");
+  positive("unpowered_max_current_A", unpowered_max_current_A);
+  require(unpowered_settle_samples >= 2 && unpowered_settle_samples <= UnpoweredHoldDetector::kMaxWindow,
+          "unpowered_settle_samples", unpowered_settle_samples, "must be in [2, 64]");
+  positive("unpowered_max_speed_rev_per_s", unpowered_max_speed_rev_per_s);
+  require(std::isfinite(unpowered_min_load_margin_kN) && unpowered_min_load_margin_kN >= 0.0,
+          "unpowered_min_load_margin_kN", unpowered_min_load_margin_kN, "must be >= 0");
+  positive("unpowered_kN", unpowered_kN);
   require(stuck_frozen_samples >= 2, "stuck_frozen_samples", stuck_frozen_samples, "must be >= 2");
   require(std::isfinite(stuck_frozen_run_factor) && stuck_frozen_run_factor >= 0.0, "stuck_frozen_run_factor",
           stuck_frozen_run_factor, "must be finite and >= 0");
@@ -209,6 +216,7 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
     stuck_.on_rejoin();
     step_.on_rejoin();
     moving_step_.on_rejoin();
+    unpowered_.on_rejoin();
     dropout_.on_rejoin();
   }
   if (!check.usable()) return;  // corrupt: counted by the guard, never used
@@ -219,6 +227,7 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   stuck_.update(c, p_, arbiter_);
   step_.update(c, p_, arbiter_);
   moving_step_.update(c, p_, arbiter_);
+  unpowered_.update(c, p_, arbiter_);
   // A resolver named offset (and not stuck: the finding is its first) still measures the motion:
   // less the offsets its confirmed jumps measured, the position the residual rules need.
   // Only while every step since the start was seen: an offset that began in a gap (a silent

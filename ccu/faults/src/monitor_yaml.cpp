@@ -100,6 +100,15 @@ MonitorParams read_monitor_params(Reader& r) {
   }
   st.finish();
 
+  auto up = r.map("unpowered");
+  p.unpowered_hold = up.boolean("enabled");
+  p.unpowered_max_current_A = up.number("max_current_A", pos);
+  p.unpowered_settle_samples = static_cast<int>(up.integer("settle_samples", 2, UnpoweredHoldDetector::kMaxWindow));
+  p.unpowered_max_speed_rev_per_s = up.number("max_speed_rev_per_s", pos);
+  p.unpowered_min_load_margin_kN = up.number("min_load_margin_kN", config::Range::non_negative());
+  p.unpowered_kN = up.number("kN", pos);
+  up.finish();
+
   auto n = r.map("noise");
   p.noise_window_samples = static_cast<int>(n.integer("window_samples", 4, kMaxNoiseWindow));
   p.noise_step_kN = n.number("step_kN", pos);

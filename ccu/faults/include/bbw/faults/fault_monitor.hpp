@@ -32,6 +32,7 @@
 #include "bbw/faults/detectors/step_detector.hpp"
 #include "bbw/faults/detectors/torque_detector.hpp"
 #include "bbw/faults/detectors/tracking_detector.hpp"
+#include "bbw/faults/detectors/unpowered_hold_detector.hpp"
 #include "bbw/faults/finding.hpp"
 #include "bbw/plant/params.hpp"
 
@@ -206,6 +207,21 @@ struct MonitorParams {
   // while the resolver is named stuck (false: not judged; the pads are off, and the spindle's
   // friction vanishes when the drive's unseen motion stops).
   bool step_moving_resolver_stuck_pads_off = false;
+
+  // A load cell on a corner whose resolver is named stuck while the drive held (its frozen speed
+  // within unpowered_max_speed_rev_per_s; a rotor frozen at speed coasts on for up to 0.2 s with
+  // the force rising), its motor unpowered (the current within unpowered_max_current_A)
+  // (UnpoweredHoldDetector): the mean of the last unpowered_settle_samples load-cell values is the
+  // reference while it is at a load the pads surely carry (eol_friction_half_width_kN + eol_band_kN
+  // + unpowered_min_load_margin_kN); it follows that mean down, never up, and a load cell above it
+  // by more than unpowered_kN for residual_persist_s is a LoadCellOffset (a held drive without
+  // current keeps its clamp force or the load drives it back; nothing raises it).
+  bool unpowered_hold = true;
+  double unpowered_max_current_A = 0.5;
+  double unpowered_max_speed_rev_per_s = 0.5;
+  int unpowered_settle_samples = 20;
+  double unpowered_min_load_margin_kN = 0.5;
+  double unpowered_kN = 0.5;
 
   // Noise: in a window of the residual's sample-to-sample changes, the share larger than
   // noise_step_kN (a single step, e.g. a bias or a resolver jump, is one sample, not noise).
@@ -444,6 +460,7 @@ class FaultMonitor {
   TorqueDetector torque_;
   StepDetector step_;
   MovingStepDetector moving_step_;
+  UnpoweredHoldDetector unpowered_;
   TrackingDetector tracking_;
   LinkDetector link_;
   // The previous usable sample (continuity for the detectors; broken by a rejoin).
