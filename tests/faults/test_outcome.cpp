@@ -40,6 +40,46 @@ TEST(FaultScorer, OnlyTheRightFindingOnItsCornerWithinTheWindowDetects) {
   EXPECT_TRUE(clean.false_alarms.empty());
 }
 
+// Masked faults (docs/faults.md, "Masked faults"): a stuck resolver leaves its corner's motor
+// without current, so an actuator fault there cannot show until the resolver lives again; a link
+// silence hides any fault on its corner until the link is back. The window (and the latency) runs
+// from then; a fault hidden until its end is masked: neither detected nor missed.
+TEST(FaultScorer, AFaultAnotherHidesIsScoredFromWhenItCouldShow) {
+  FaultSpec stuck = fault(Target::FR, Part::Resolver, FaultType::Stuck, 2.3);
+  stuck.duration_s = 1.3;  // lives again at 3.6 s
+  const FaultSpec loss = fault(Target::FR, Part::Actuator, FaultType::TotalLoss, 2.4);
+  EXPECT_DOUBLE_EQ(observable_from(loss, {stuck, loss}), 3.6);
+  // Named 0.3 s after the resolver lives again, 1.5 s after the injection: in its 0.5 s window.
+  const RunScore s = score_run({stuck, loss}, {{Target::FR, Finding::ResolverStuck, 2.3, 2.32},
+                                               {Target::FR, Finding::ActuatorLost, 3.7, 3.9}});
+  ASSERT_EQ(s.outcomes.size(), 2u);
+  EXPECT_TRUE(s.outcomes[1].detected);
+  EXPECT_FALSE(s.outcomes[1].masked);
+  EXPECT_NEAR(s.outcomes[1].latency_ms, 300.0, 1e-6);
+  EXPECT_TRUE(s.false_alarms.empty());
+  // Alone (no stuck resolver), the same finding is 1.5 s late: a miss.
+  EXPECT_FALSE(score_run({loss}, {{Target::FR, Finding::ActuatorLost, 3.7, 3.9}}).outcomes[0].detected);
+  // A resolver stuck to the end masks the loss: neither detected nor missed, even if named.
+  FaultSpec stuck_for_good = stuck;
+  stuck_for_good.duration_s.reset();
+  const RunScore m = score_run({stuck_for_good, loss}, {{Target::FR, Finding::ActuatorLost, 2.4, 2.5}});
+  EXPECT_TRUE(m.outcomes[1].masked);
+  EXPECT_FALSE(m.outcomes[1].detected);
+  // Only actuator faults: a load-cell bias on that corner is scored from its injection.
+  const FaultSpec bias = fault(Target::FR, Part::LoadCell, FaultType::Bias, 2.4);
+  EXPECT_DOUBLE_EQ(observable_from(bias, {stuck_for_good, bias}), 2.4);
+  // Only on its corner, and only from its onset: a loss before the resolver stuck is its own.
+  EXPECT_DOUBLE_EQ(observable_from(fault(Target::RL, Part::Actuator, FaultType::TotalLoss, 2.4), {stuck}), 2.4);
+  EXPECT_DOUBLE_EQ(observable_from(fault(Target::FR, Part::Actuator, FaultType::Seized, 2.0), {stuck}), 2.0);
+  // A silence hides any fault on its corner; masks chain (the silence ends inside the stuck resolver).
+  FaultSpec silence = fault(Target::FR, Part::Network, FaultType::Silence, 2.0);
+  silence.duration_s = 0.5;
+  EXPECT_DOUBLE_EQ(observable_from(bias, {silence, bias}), 2.5);
+  EXPECT_DOUBLE_EQ(observable_from(fault(Target::FR, Part::Actuator, FaultType::Seized, 2.1), {silence, stuck}), 3.6);
+  // A fault never masks itself.
+  EXPECT_DOUBLE_EQ(observable_from(silence, {silence}), 2.0);
+}
+
 // A killed corner restarted 0.5 s later: lost link first (within 0.1 s), then named a process
 // loss when its new incarnation joins, which on a loaded machine can be 0.2 s or more after the
 // restart; the naming is explained up to the participant lease (2 s), not only up to the

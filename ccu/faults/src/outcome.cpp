@@ -97,6 +97,32 @@ bool right_finding(const FaultSpec& f, Finding d) {
 
 namespace {
 
+bool masks(const FaultSpec& by, const FaultSpec& f) {
+  const bool itself = by.type == f.type && by.part == f.part && by.at_s == f.at_s;
+  if (itself || by.target != f.target || is_ccu(by.target)) return false;
+  if (by.type == FaultType::Silence) return true;
+  const bool actuator = f.type == FaultType::TorqueLoss || f.type == FaultType::TotalLoss || f.type == FaultType::Seized;
+  return actuator && by.part == Part::Resolver && by.type == FaultType::Stuck;
+}
+
+}  // namespace
+
+double observable_from(const FaultSpec& f, const std::vector<FaultSpec>& faults) {
+  double from_s = f.at_s;
+  for (bool moved = true; moved && std::isfinite(from_s);) {
+    moved = false;
+    for (const FaultSpec& g : faults) {
+      if (masks(g, f) && g.at_s <= from_s + 1e-9 && g.end_s() > from_s + 1e-9) {
+        from_s = g.end_s();
+        moved = true;
+      }
+    }
+  }
+  return from_s;
+}
+
+namespace {
+
 // The participants' discovery lease (config/dds/bbw_profiles.xml, leaseDuration 2 s): a killed
 // process is named (process_lost) by the lease running out, or earlier by its restarted
 // incarnation's first samples, which may come well after the restart (its discovery).
@@ -124,7 +150,12 @@ RunScore score_run(const std::vector<FaultSpec>& faults, const std::vector<Detec
     if (is_ccu(f.target)) continue;
     FaultOutcome r;
     r.fault = f;
-    const double until_s = f.at_s + detection_window_s(f) + 1e-9;
+    r.observable_s = observable_from(f, faults);
+    if (!(r.observable_s < f.end_s() - 1e-9)) {
+      r.masked = true;
+      r.observable_s = std::min(r.observable_s, f.end_s());
+    }
+    const double until_s = r.observable_s + detection_window_s(f) + 1e-9;
     const DetectionEvent* first_right = nullptr;
     const DetectionEvent* first_any = nullptr;
     for (const DetectionEvent& d : detections) {
@@ -158,10 +189,10 @@ RunScore score_run(const std::vector<FaultSpec>& faults, const std::vector<Detec
       r.diagnosis_latency_ms = 1e3 * (first_any->detected_s - f.at_s);
       r.reaction = reaction_to(first_any->finding);
     }
-    if (first_right != nullptr) {
+    if (first_right != nullptr && !r.masked) {
       r.detected = true;
       r.detected_s = first_right->detected_s;
-      r.latency_ms = 1e3 * (first_right->detected_s - f.at_s);
+      r.latency_ms = 1e3 * std::max(0.0, first_right->detected_s - r.observable_s);
       bool clean = true;
       for (const DetectionEvent& d : score.false_alarms) {
         clean = clean && !(d.corner == f.target && d.detected_s >= f.at_s - 1e-9 && d.detected_s <= until_s);

@@ -328,7 +328,7 @@ int cmd_report(const std::string& dir) {
     else ++missing;
   }
   std::map<std::string, Group> by_kind, by_onset;
-  Group all, bias_1kN, loss_stuck, below_limit;
+  Group all, bias_1kN, loss_stuck, below_limit, masked;
   long long failed = 0, ff_runs = 0, ff_alarms = 0, faulty_run_alarms = 0, runs_with_alarms = 0;
   double ff_hours = 0.0, faulty_hours = 0.0, wall_s = 0.0;
   std::vector<std::string> alarm_list;
@@ -358,6 +358,10 @@ int cmd_report(const std::string& dir) {
         add(below_limit, r, f);
         continue;
       }
+      if (f.masked) {  // could not show before it ended: neither detected nor missed
+        add(masked, r, f);
+        continue;
+      }
       add(all, r, f);
       add(by_kind[f.kind], r, f);
       add(by_onset[f.onset], r, f);
@@ -382,6 +386,7 @@ int cmd_report(const std::string& dir) {
   group_json(j, "bias_at_least_1kN", bias_1kN);
   group_json(j, "loss_and_stuck", loss_stuck);
   group_json(j, "below_limit", below_limit);
+  group_json(j, "masked", masked);
   const double rate = ff_hours > 0.0 ? static_cast<double>(ff_alarms) / ff_hours : std::nan("");
   const double upper = ff_hours > 0.0 ? poisson_upper95(ff_alarms) / ff_hours : std::nan("");
   j.begin_object("false_alarms")
@@ -471,6 +476,11 @@ int cmd_report(const std::string& dir) {
   for (std::size_t i = 0; i < std::min<std::size_t>(alarm_list.size(), 100); ++i) h << "<li>" << alarm_list[i] << "</li>";
   h << "</ul><h2>Misses</h2><ul>";
   for (const auto& m : all.misses) h << "<li>" << m << "</li>";
+  h << "</ul><h2>Masked faults</h2><p>" << masked.n
+    << " injected faults could not show themselves before they ended (an actuator fault while its corner's resolver was"
+       " stuck and its motor without current, any fault while its corner's link was silent; docs/faults.md, \"Masked"
+       " faults\"): not counted above, neither detected nor missed.</p><ul>";
+  for (const auto& m : masked.misses) h << "<li>" << m << "</li>";
   h << "</ul>";
   if (plots) h << "<h2>Plots</h2><img src='plots/coverage.png'><br><img src='plots/latency.png'><br><img src='plots/harm.png'>";
   if (all.n == 0) h << "<p>No fault was injected: no coverage, latency or harm to plot.</p>";
@@ -479,6 +489,7 @@ int cmd_report(const std::string& dir) {
   std::cout << "bbw_campaign: " << spec.name << ": "
             << (all.n ? "coverage " + std::to_string(all.detected) + "/" + std::to_string(all.n) + " (" + fmt(100.0 * all.detected / all.n, 2) + " %)"
                       : std::string("no fault injected"))
+            << (masked.n ? ", " + std::to_string(masked.n) + " masked" : std::string())
             << ", false alarms " << ff_alarms << " in " << fmt(ff_hours, 2)
             << " h fault-free (+" << faulty_run_alarms << " in faulty runs), " << failed << " failed runs; " << dir
             << "/campaign.json, " << dir << "/report.html\n";

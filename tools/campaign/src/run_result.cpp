@@ -51,6 +51,8 @@ void score_into(RunResult& r, const std::vector<faults::FaultSpec>& specs, const
     row.latency_ms = o.detected ? o.latency_ms : -1.0;
     row.diagnosis = faults::diagnosis_name(o);
     row.window_s = faults::detection_window_s(o.fault);
+    row.masked = o.masked || !(o.observable_s < row.end_s - 1e-9);  // or masked until the run ended
+    row.observable_s = std::min(o.observable_s, row.end_s);
     row.above_limit = above_limit(row.kind, row.magnitude, row.at_s, row.end_s);
     // Harm while undetected, from the CCU's log of the corner.
     csv::ReadOptions opt;
@@ -93,6 +95,8 @@ void save_result(const RunResult& r, const std::string& file) {
         .value("end_s", f.end_s)
         .value("magnitude", f.magnitude)
         .value("above_limit", f.above_limit)
+        .value("masked", f.masked)
+        .value("observable_s", f.observable_s)
         .value("detected", f.detected)
         .value("correct", f.correct)
         .value("latency_ms", f.latency_ms)
@@ -138,6 +142,8 @@ RunResult load_result(const std::string& file) {
       row.end_s = f["end_s"].as<double>();
       row.magnitude = f["magnitude"].as<double>();
       row.above_limit = f["above_limit"].as<bool>();
+      row.masked = f["masked"].as<bool>();  // a result written before masking was scored: run it again
+      row.observable_s = f["observable_s"].as<double>();
       row.detected = f["detected"].as<bool>();
       row.correct = f["correct"].as<bool>();
       row.latency_ms = f["latency_ms"].as<double>();

@@ -19,6 +19,8 @@ struct FaultRow {
   double end_s = 0.0;       // the fault's end (or the run's)
   double magnitude = 0.0;   // in the kind's unit (draw.hpp); 0 for kinds without one
   bool above_limit = true;  // |magnitude| >= the stated detectability limit
+  bool masked = false;       // another fault on its corner hid it until it ended (faults::observable_from)
+  double observable_s = 0.0; // when it could first show (its window and latency run from here)
   bool detected = false;
   bool correct = false;
   double latency_ms = -1.0;

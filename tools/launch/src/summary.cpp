@@ -300,6 +300,8 @@ RunTotals write_run_summary(const CompletedRun& run) {
         .value("type", std::string(faults::to_string(f.fault.type)))
         .value("injected_s", f.fault.at_s)
         .value("ends_s", std::min(f.fault.end_s(), scenario.duration_s))
+        .value("masked", f.masked || !(f.observable_s < std::min(f.fault.end_s(), scenario.duration_s) - 1e-9))
+        .value("observable_s", std::min(f.observable_s, std::min(f.fault.end_s(), scenario.duration_s)))
         .value("detected", f.detected)
         .value("detected_s", f.detected ? f.detected_s : -1.0)
         .value("latency_ms", f.detected ? f.latency_ms : -1.0)

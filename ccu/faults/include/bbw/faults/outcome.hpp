@@ -25,7 +25,12 @@ struct FaultOutcome {
   // its corner within the type's stated window after the injection (detection_window_s).
   bool detected = false;
   double detected_s = 0.0;      // the first right finding in the window (CCU kill: the first watchdog)
-  double latency_ms = 0.0;      // detected_s - at_s
+  double latency_ms = 0.0;      // detected_s - observable_s
+  // When the fault could first show itself (observable_from): its injection, or the end of what
+  // masked it there. The window runs from here. masked: nothing could show it before it ended;
+  // such a fault is neither detected nor missed (the campaign counts it apart).
+  double observable_s = 0.0;
+  bool masked = false;
   double diagnosis_s = 0.0;     // when the diagnosis below was made
   double diagnosis_latency_ms = 0.0;
   Finding diagnosis = Finding::None;  // the right finding's final form (an upgrade refines it); else the first finding
@@ -41,6 +46,14 @@ struct FaultOutcome {
 // at_s + this is a miss. Drift: the time the drift needs to reach the bias limit, plus the bias
 // window.
 double detection_window_s(const FaultSpec& fault);
+// When `fault` could first show itself, given the run's other faults (`faults`, which may hold it):
+// its injection, unless another fault on its corner masks it then, and then that fault's end,
+// again as long as one masks it (+inf: masked until the end). Masking (docs/faults.md, "Masked
+// faults"): a link silence masks any fault on its corner (the CCU hears nothing of it); a stuck
+// resolver masks an actuator fault (torque loss, total loss, seized: the corner cannot commutate
+// its motor and drives no current, corner_unit::ControllerParams::frozen_resolver_samples, so a
+// drive without torque and a healthy one without current are the same drive).
+double observable_from(const FaultSpec& fault, const std::vector<FaultSpec>& faults);
 // Whether `finding` names `fault` rightly (its part and type; e.g. a bias or drift is a
 // load_cell_offset, a seized actuator is actuator_lost or actuator_not_releasing).
 bool right_finding(const FaultSpec& fault, Finding finding);
