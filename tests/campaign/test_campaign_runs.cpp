@@ -55,15 +55,17 @@ std::string small_spec_with(const std::string& dir, int runs, const std::string&
 
 // The CI subset (config/campaigns/ci.yaml, 36 runs, every kind, onset and profile): every fault
 // above its limit detected rightly within its window, and nothing else raised.
-// The goal for this subset is every fault detected and no false alarm; the diagnosis does
-// not reach it yet (docs/faults.md, "Diagnosis across calipers and driving": 32 of 39 detected,
+// The goal for this subset is every fault detected and no false alarm: reached since the
+// nineteenth session (39 of 39, 0, 0; 38 of 39 scoring windows from the injection, before a
+// fault hidden by a link silence was scored from the link's return). Before (docs/faults.md,
+// "Diagnosis across calipers and driving": 32 of 39 detected,
 // 1 + 1 false alarms with the fourth session's rules (2026-11-26); 25 of 39, 1 + 2 with only
 // credible fits judged, 2 + 8 before, 3 + 9 after the local loop's
 // fix, 5 + 13 before it, measured 2026-11-23). Lockstep runs are deterministic, so the subset is a
 // ratchet: it fails when the diagnosis gets worse than measured, and its bounds move to the goal
 // as the diagnosis improves (kMinDetected up to n, the false-alarm bounds down to 0).
 TEST(CampaignSystem, CiSubsetOverDdsIsNoWorseThanMeasured) {
-  constexpr int kMinDetected = 38;             // goal: every fault (36 before the sixteenth session, 35 before the fifteenth, 34 before the thirteenth, 32 before the twelfth, 25 before the fourth session's rules)
+  constexpr int kMinDetected = 39;             // the goal: every fault, since the nineteenth session's masked-fault scoring (a fault hidden by a link silence scored from the link's return; 38 before, 36 before the sixteenth session, 35 before the fifteenth, 34 before the thirteenth, 32 before the twelfth, 25 before the fourth session's rules)
   constexpr int kMaxFalseAlarmsFaultFree = 0;  // the goal, met since the fifth session (1 before it, 2 before credible fits, 3 before the friction memory, 5 before the local loop's fix)
   constexpr int kMaxFalseAlarmsFaulty = 0;     // the goal, met since the sixth session (1 before it; 2 before the fourth session's rules, 8 before credible fits, 9 before the friction memory, 13 before the local loop's fix)
   const std::string dir = bbw::system_test::scratch("campaign", "ci");
