@@ -65,6 +65,9 @@ TEST(FaultScorer, AFaultAnotherHidesIsScoredFromWhenItCouldShow) {
   const RunScore m = score_run({stuck_for_good, loss}, {{Target::FR, Finding::ActuatorLost, 2.4, 2.5}});
   EXPECT_TRUE(m.outcomes[1].masked);
   EXPECT_FALSE(m.outcomes[1].detected);
+  // ... and so does one that lives again only after the run ended.
+  EXPECT_TRUE(score_run({stuck, loss}, {}, 3.0).outcomes[1].masked);
+  EXPECT_FALSE(score_run({stuck, loss}, {}, 4.0).outcomes[1].masked);
   // Only actuator faults: a load-cell bias on that corner is scored from its injection.
   const FaultSpec bias = fault(Target::FR, Part::LoadCell, FaultType::Bias, 2.4);
   EXPECT_DOUBLE_EQ(observable_from(bias, {stuck_for_good, bias}), 2.4);

@@ -138,7 +138,8 @@ bool explains(const FaultSpec& f, const DetectionEvent& d) {
 
 }  // namespace
 
-RunScore score_run(const std::vector<FaultSpec>& faults, const std::vector<DetectionEvent>& detections) {
+RunScore score_run(const std::vector<FaultSpec>& faults, const std::vector<DetectionEvent>& detections,
+                   double run_end_s) {
   RunScore score;
   for (const DetectionEvent& d : detections) {
     if (d.finding == Finding::None) continue;
@@ -151,9 +152,10 @@ RunScore score_run(const std::vector<FaultSpec>& faults, const std::vector<Detec
     FaultOutcome r;
     r.fault = f;
     r.observable_s = observable_from(f, faults);
-    if (!(r.observable_s < f.end_s() - 1e-9)) {
+    const double end_s = std::min(f.end_s(), run_end_s);
+    if (!(r.observable_s < end_s - 1e-9)) {
       r.masked = true;
-      r.observable_s = std::min(r.observable_s, f.end_s());
+      r.observable_s = std::min(r.observable_s, end_s);
     }
     const double until_s = r.observable_s + detection_window_s(f) + 1e-9;
     const DetectionEvent* first_right = nullptr;

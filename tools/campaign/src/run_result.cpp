@@ -33,7 +33,7 @@ double magnitude_of(const faults::FaultSpec& f) {
 void score_into(RunResult& r, const std::vector<faults::FaultSpec>& specs, const std::vector<std::string>& kinds,
                 const std::vector<std::string>& onsets, const std::vector<faults::DetectionEvent>& detections,
                 const std::string& out_dir, double run_end_s) {
-  const faults::RunScore score = faults::score_run(specs, detections);
+  const faults::RunScore score = faults::score_run(specs, detections, run_end_s);
   for (const auto& d : score.false_alarms) {
     r.false_alarms.push_back({faults::to_string(d.corner), faults::to_string(d.finding), d.detected_s});
   }
@@ -51,8 +51,8 @@ void score_into(RunResult& r, const std::vector<faults::FaultSpec>& specs, const
     row.latency_ms = o.detected ? o.latency_ms : -1.0;
     row.diagnosis = faults::diagnosis_name(o);
     row.window_s = faults::detection_window_s(o.fault);
-    row.masked = o.masked || !(o.observable_s < row.end_s - 1e-9);  // or masked until the run ended
-    row.observable_s = std::min(o.observable_s, row.end_s);
+    row.masked = o.masked;
+    row.observable_s = o.observable_s;
     row.above_limit = above_limit(row.kind, row.magnitude, row.at_s, row.end_s);
     // Harm while undetected, from the CCU's log of the corner.
     csv::ReadOptions opt;

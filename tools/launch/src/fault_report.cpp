@@ -68,7 +68,7 @@ std::vector<faults::DetectionEvent> false_alarms(const faults::FaultSchedule& sc
 std::vector<FaultResult> assess_faults(const faults::FaultSchedule& schedule, const std::vector<Detection>& detections,
                                        const std::map<std::string, double>& ccu_lost_s,
                                        const std::vector<TimelinePoint>& timeline, double run_end_s) {
-  const faults::RunScore score = faults::score_run(schedule.faults, detection_events(detections));
+  const faults::RunScore score = faults::score_run(schedule.faults, detection_events(detections), run_end_s);
   std::vector<double> lost;
   for (const auto& [corner, t] : ccu_lost_s) lost.push_back(t);
   std::vector<FaultResult> out;

@@ -37,8 +37,7 @@ void UnpoweredHoldDetector::update(const SampleContext& c, const MonitorParams& 
   // The level may fall (the load drives the spindle back, the keys' friction turns with it), never rise.
   ref_kN_ = have_ref_ ? std::min(ref_kN_, mean) : mean;
   have_ref_ = true;
-  change_kN_ = r.force_kN - ref_kN_;
-  if (change_kN_ > p.unpowered_kN) {
+  if (r.force_kN - ref_kN_ > p.unpowered_kN) {
     if (!over_) {
       over_ = true;
       over_since_s_ = t;

@@ -3,6 +3,7 @@
 // closed-loop tests (tests/faults, from CcuNode::detections()). Pure.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -66,7 +67,9 @@ struct RunScore {
   std::vector<FaultOutcome> outcomes;         // in schedule order (CCU kills scored elsewhere: not here)
   std::vector<DetectionEvent> false_alarms;   // in detection order
 };
-RunScore score_run(const std::vector<FaultSpec>& faults, const std::vector<DetectionEvent>& detections);
+// run_end_s: a fault hidden until then is masked too.
+RunScore score_run(const std::vector<FaultSpec>& faults, const std::vector<DetectionEvent>& detections,
+                   double run_end_s = std::numeric_limits<double>::infinity());
 
 // One corner fault alone (score_run with that fault only).
 FaultOutcome score_fault(const FaultSpec& fault, const std::vector<DetectionEvent>& detections);
