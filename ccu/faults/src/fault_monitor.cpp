@@ -227,7 +227,7 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   stuck_.update(c, p_, arbiter_);
   step_.update(c, p_, arbiter_);
   moving_step_.update(c, p_, arbiter_);
-  unpowered_.update(c, p_, arbiter_);
+  unpowered_.update(c, commutation_lost(), p_, arbiter_);
   // A resolver named offset (and not stuck: the finding is its first) still measures the motion:
   // less the offsets its confirmed jumps measured, the position the residual rules need.
   // Only while every step since the start was seen: an offset that began in a gap (a silent

@@ -21,7 +21,8 @@ namespace bbw::faults {
 class UnpoweredHoldDetector {
  public:
   static constexpr int kMaxWindow = 64;
-  void update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a);
+  // commutation_lost: the resolver is named stuck (FaultMonitor::commutation_lost).
+  void update(const SampleContext& c, bool commutation_lost, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() { reset(); }
 
  private:
