@@ -726,6 +726,17 @@ TEST(ClosedLoopIssue14, ATotalLossWhileApplyingAtSpeedIsNamedByTheBrakingRule) {
                                             [](MonitorParams& m) { m.torque_lost_braking = false; });
 }
 
+// A 59 % torque loss while the demand comes down slowly, then a load-cell bias on the same corner
+// 0.121 s later (stress seed 1406 run 112): the motor holds the screw back against the load, and
+// the weaker motor needs more current for it. The torque-loss rule while braking at speed names
+// the loss before the bias; without it the loss is not named in its window (the bias takes the
+// load cell the other rules judge it by).
+TEST(ClosedLoopIssue14, ATorqueLossInASlowReleaseIsNamedWhileTheMotorHoldsBack) {
+  expect_both_named_fault_k_only_with_the_rule("config/scenarios/faults/torque_loss_then_a_load_cell_bias_in_a_slow_release.yaml", 0,
+                                               "the torque-loss rule while braking at speed",
+                                               [](MonitorParams& m) { m.torque_loss_braking_threshold = 0.0; });
+}
+
 // A total loss 0.1 s after a resolver offset on the same corner (tuning seed 1403 run 780): the
 // torque rules go on with the resolver's speed and its position less the offset.
 TEST(ClosedLoopIssue14, ATotalLossAfterAResolverOffsetIsNamedByTheTorqueRules) {

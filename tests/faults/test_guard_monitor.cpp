@@ -544,10 +544,45 @@ TEST(FaultMonitor, ATorqueLossIsNamedDuringAnApplyBelowTheHoldChecksLoad) {
   EXPECT_FALSE(run(base, 1.0, 1.5, 5.0, 5.0).present);
   EXPECT_EQ(run(base, 0.4, 1.5, 5.0, 5.0).finding, Finding::ActuatorTorqueLoss);
   EXPECT_FALSE(run(base, 1.0, 1.5, 7.0, 5.0).present);   // the load cell 2 kN low
-  EXPECT_FALSE(run(base, 0.4, -1.5, 5.0, 5.0).present);  // releasing
+  MonitorParams no_braking = base;
+  no_braking.torque_loss_braking_threshold = 0.0;
+  EXPECT_FALSE(run(no_braking, 0.4, -1.5, 5.0, 5.0).present);  // releasing (the braking rule below)
   MonitorParams off = base;
   off.torque_check_moving_min_speed_rev_per_s = 0.0;
   EXPECT_FALSE(run(off, 0.4, 1.5, 5.0, 5.0).present);
+}
+
+// Releasing slowly under load the motor holds the screw back against the load less the drive's
+// friction; a weaker motor needs proportionally more current for it (twentieth session, tuning
+// seed 1406 run 112: a 59 % loss in a slow release at 7 kN, found only after it had ended).
+TEST(FaultMonitor, ATorqueLossIsNamedWhileTheMotorHoldsBackARelease) {
+  MonitorParams base = noiseless();
+  SampleCheck ok;
+  auto run = [&](const MonitorParams& p, double fraction, double speed_rev_per_s, double true_kN, double lc_kN) {
+    FaultMonitor m(p, Target::FL);
+    const double friction_Nm = bbw::plant::drive_friction_Nm(p.drive, speed_rev_per_s);
+    for (int k = 1; k < 200; ++k) {
+      const double t = 0.001 * k;
+      const double rise_kN = 2.0 * speed_rev_per_s * t;  // 2 kN/rev
+      auto r = at(k, t, 3.0 + speed_rev_per_s * t, lc_kN + rise_kN);
+      r.speed_rev_per_s = speed_rev_per_s + (k % 2 == 0 ? 1e-4 : -1e-4);  // a real speed never repeats exactly
+      r.motor_current_A = ((true_kN + rise_kN) * p.Nm_per_kN + friction_Nm) / (p.torque_per_A_Nm * fraction);
+      m.update(r, ok, nullptr, r.force_kN, t);
+    }
+    EXPECT_TRUE(m.ok(Part::LoadCell) && m.ok(Part::Resolver));
+    return m.diagnosis(Part::Actuator);
+  };
+  ASSERT_GT(0.0, bbw::plant::drive_friction_Nm(base.drive, -1.5));  // the friction helps the motor hold back
+  EXPECT_FALSE(run(base, 1.0, -1.5, 7.0, 7.0).present);
+  const Diagnosis d = run(base, 0.4, -1.5, 7.0, 7.0);
+  ASSERT_TRUE(d.present);
+  EXPECT_EQ(d.finding, Finding::ActuatorTorqueLoss);  // not lost: 0.4 of the torque is there
+  EXPECT_FALSE(run(base, 0.4, -1.5, 3.0, 3.0).present);  // below check_moving_min_load_kN
+  EXPECT_FALSE(run(base, 0.4, -0.3, 7.0, 7.0).present);  // slower than check_moving_min_speed_rev_per_s
+  EXPECT_FALSE(run(base, 1.0, -1.5, 7.0, 8.0).present);  // the load cell 1 kN high
+  MonitorParams off = base;
+  off.torque_loss_braking_threshold = 0.0;
+  EXPECT_FALSE(run(off, 0.4, -1.5, 7.0, 7.0).present);
 }
 
 // Over-application: told to release (command 0) a brake that keeps 10 kN and does not move back
@@ -790,6 +825,62 @@ TEST(FaultMonitor, AnUnexplainedTorqueNearStandstillIsALostActuatorAtAnyLoad) {
   // Pulling with the whole current limit the other way while the brake holds (seized in a release).
   auto seized_release = run(x6, f6, [&](int) { return -40.0; }, 200);
   EXPECT_EQ(seized_release.diagnosis(Part::Actuator).finding, Finding::ActuatorLost);
+}
+
+// Below the moving check's load (issue 14, twentieth session: tuning seed 1403 run 72, a 66 %
+// loss in a slow apply named only at 4 kN, 1.035 s after it) the torque-loss rule judges an apply,
+// and a release the motor holds back, with the larger plausible load: the end-of-line curve's
+// with its band, so a load cell that reads low is not a weak motor. A healthy drive, also one
+// whose load cell reads 1.4 kN low in a release, is not named; a 70 % loss applying at 3 kN is,
+// but not with the low-load check off, nor without the curve (no plausible load: the apply is
+// not judged below the moving check's load).
+TEST(FaultMonitor, ATorqueLossBelowTheMovingChecksLoadIsJudgedWithTheLargerPlausibleLoad) {
+  MonitorParams p = noiseless();
+  p.eol_curve = bbw::plant::ClampCurveParams{};
+  p.eol_friction_half_width_kN = 1.0;
+  const bbw::plant::ClampCurve eol{*p.eol_curve};
+  const double T = p.eol_curve->reference_temperature_C;
+  auto position_of = [&](double force_kN) {
+    double lo = 0.5, hi = 10.0;
+    for (int i = 0; i < 60; ++i) ((eol.force_kN(0.5 * (lo + hi), T, 0.0) < force_kN) ? lo : hi) = 0.5 * (lo + hi);
+    return 0.5 * (lo + hi);
+  };
+  SampleCheck ok;
+  // From the position of `true_kN` at `speed`, the load cell `offset_kN` off the curve, the
+  // current a drive with `fraction` of its torque needs.
+  auto run = [&](const MonitorParams& mp, double fraction, double speed_rev_per_s, double true_kN, double offset_kN) {
+    FaultMonitor m(mp, Target::FL);
+    const double x0 = position_of(true_kN);
+    const double friction_Nm = bbw::plant::drive_friction_Nm(mp.drive, speed_rev_per_s);
+    for (int k = 1; k < 150; ++k) {
+      const double t = 0.001 * k, x = x0 + speed_rev_per_s * t;
+      const double load_kN = eol.force_kN(x, T, 0.0);
+      auto r = at(k, t, x, load_kN + offset_kN);
+      r.temperature_C = T;
+      r.speed_rev_per_s = speed_rev_per_s + (k % 2 == 0 ? 1e-4 : -1e-4);
+      r.motor_current_A = (load_kN * mp.Nm_per_kN + friction_Nm) / (mp.torque_per_A_Nm * fraction);
+      m.update(r, ok, nullptr, r.force_kN, t);
+    }
+    return m;
+  };
+  ASSERT_LT(3.0, p.torque_check_moving_min_load_kN);
+  ASSERT_GT(3.0, p.torque_check_moving_low_load_kN);
+  EXPECT_TRUE(run(p, 1.0, 0.8, 3.0, 0.0).ok(Part::Actuator));
+  auto weak = run(p, 0.3, 0.8, 3.0, 0.0);
+  EXPECT_EQ(weak.diagnosis(Part::Actuator).finding, Finding::ActuatorTorqueLoss);
+  EXPECT_TRUE(weak.ok(Part::LoadCell));
+  MonitorParams off = p;
+  off.torque_check_moving_low_load_kN = 0.0;
+  EXPECT_TRUE(run(off, 0.3, 0.8, 3.0, 0.0).ok(Part::Actuator));
+  MonitorParams no_curve = noiseless();
+  EXPECT_TRUE(run(no_curve, 0.3, 0.8, 3.0, 0.0).ok(Part::Actuator));
+  // A healthy drive holding back a release from 4.5 kN, its load cell 1.4 kN low (within the
+  // curve's band): not named (its made torque, 0.13 Nm, is below check_min_torque_Nm, so no
+  // balance judges it; the larger plausible load is the guard when the drive also decelerates).
+  auto low = run(p, 1.0, -1.5, 4.5, -1.4);
+  EXPECT_TRUE(low.ok(Part::Actuator));
+  EXPECT_TRUE(low.ok(Part::LoadCell));
+  EXPECT_EQ(run(p, 0.4, -1.5, 7.0, 0.0).diagnosis(Part::Actuator).finding, Finding::ActuatorTorqueLoss);
 }
 
 // A drive that seizes in a held stop (issue 14, tune_b run 376): the healthy hold sits at about

@@ -57,7 +57,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(torque_filter_s); SAME(torque_check_min_load_kN); SAME(torque_check_min_torque_Nm);
   SAME(torque_fraction_threshold); SAME(torque_check_max_speed_rev_per_s); SAME(torque_check_moving_min_speed_rev_per_s); SAME(torque_check_moving_min_load_kN);
   SAME(torque_persist_s);
-  SAME(torque_lost_threshold); SAME(torque_lost_persist_s); SAME(torque_loss_rescales_drive); SAME(torque_lost_unmeasured_load_high); SAME(torque_lost_braking); SAME(torque_lost_braking_threshold); SAME(torque_after_resolver_offset); SAME(torque_stop_margin_rev);
+  SAME(torque_lost_threshold); SAME(torque_lost_persist_s); SAME(torque_loss_rescales_drive); SAME(torque_lost_unmeasured_load_high); SAME(torque_lost_braking); SAME(torque_lost_braking_threshold); SAME(torque_loss_braking_threshold); SAME(torque_check_moving_low_load_kN); SAME(torque_after_resolver_offset); SAME(torque_stop_margin_rev);
   SAME(test_pulse_max_speed_rev_per_s); SAME(test_pulse_answer_ratio); SAME(test_pulse_unanswered); SAME(test_pulse_within_s);
   SAME(test_pulse_lost_mean_ratio); SAME(test_pulse_crossing_extremes); SAME(test_pulse_rescaled_after_loss); SAME(test_pulse_weak_count); SAME(test_pulse_weak_fraction);
   SAME(test_pulse_healthy_ratio); SAME(test_pulse_learn_count);

@@ -65,7 +65,8 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
                fs.scenario.name == "load_cell_dropout_released_onto_the_end_stop" ||
                fs.scenario.name == "torque_loss_then_a_stuck_load_cell_in_a_hold" ||
                fs.scenario.name == "resolver_stuck_then_a_load_cell_bias_in_a_hard_stop" ||
-               fs.scenario.name == "load_cell_drift_after_a_stuck_resolver_in_a_hard_stop") {  // two faults, one corner
+               fs.scenario.name == "load_cell_drift_after_a_stuck_resolver_in_a_hard_stop" ||
+               fs.scenario.name == "torque_loss_then_a_load_cell_bias_in_a_slow_release") {  // two faults, one corner
       ASSERT_EQ(fs.faults.faults.size(), 2u) << entry.path();
       EXPECT_EQ(fs.faults.faults[0].target, fs.faults.faults[1].target);
       for (const auto& f : fs.faults.faults) types.insert(f.type);
@@ -74,11 +75,11 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
       types.insert(fs.faults.faults[0].type);
     }
   }
-  EXPECT_EQ(files, 38u);  // actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four
+  EXPECT_EQ(files, 39u);  // actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four
                           // times: in a hold, while applying, before the first fit, in a hard stop released on the
                           // curve; load_cell drift four times: in a stop, followed by the loop in a hard stop,
                           // while the brake modulates, below the trusted range; load_cell dropout twice: in a
-                          // stop, across a reversal; torque_loss twice: applying, in a hold; a load-cell drift
+                          // stop, across a reversal; torque_loss twice: applying, in a hold; a torque loss then a load-cell bias in a slow release; a load-cell drift
                           // then a resolver offset on one corner; a load-cell drift then a total loss, released, on
                           // one corner; a load-cell drift on a caliper seized at the pads; a total loss while
                           // applying at speed; a resolver offset then a total loss, then a seizure in a hard stop,

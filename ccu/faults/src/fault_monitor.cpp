@@ -108,6 +108,12 @@ void MonitorParams::validate() const {
           torque_lost_threshold, "must be in (0, torque_fraction_threshold)");
   require(torque_lost_braking_threshold > 0.0 && torque_lost_braking_threshold <= torque_lost_threshold,
           "torque_lost_braking_threshold", torque_lost_braking_threshold, "must be in (0, torque_lost_threshold]");
+  require(torque_check_moving_low_load_kN >= 0.0 && torque_check_moving_low_load_kN <= torque_check_moving_min_load_kN,
+          "torque_check_moving_low_load_kN", torque_check_moving_low_load_kN, "must be in [0, torque_check_moving_min_load_kN]");
+  require(torque_loss_braking_threshold == 0.0 ||
+              (torque_loss_braking_threshold > torque_lost_braking_threshold && torque_loss_braking_threshold <= 1.0),
+          "torque_loss_braking_threshold", torque_loss_braking_threshold,
+          "must be 0 (off) or in (torque_lost_braking_threshold, 1]");
   positive("torque_lost_persist_s", torque_lost_persist_s);
   require(std::isfinite(drive.coulomb_friction_Nm) && drive.coulomb_friction_Nm >= 0.0, "drive.coulomb_friction_Nm",
           drive.coulomb_friction_Nm, "must be >= 0");

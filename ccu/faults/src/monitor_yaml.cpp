@@ -132,6 +132,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.torque_check_max_speed_rev_per_s = t.number("check_max_speed_rev_per_s", pos);
   p.torque_check_moving_min_speed_rev_per_s = t.number("check_moving_min_speed_rev_per_s", Range::non_negative());
   p.torque_check_moving_min_load_kN = t.number("check_moving_min_load_kN", pos);
+  p.torque_check_moving_low_load_kN = t.number("check_moving_low_load_kN", Range::non_negative());
   p.test_pulse_max_speed_rev_per_s = t.number("test_pulse_max_speed_rev_per_s", pos);
   p.test_pulse_answer_ratio = t.number("test_pulse_answer_ratio", Range{0.0, 1.0, true, true});
   p.test_pulse_unanswered = static_cast<int>(t.integer("test_pulse_unanswered", 1, 1000));
@@ -150,6 +151,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.torque_lost_unmeasured_load_high = t.boolean("lost_unmeasured_load_high");
   p.torque_lost_braking = t.boolean("lost_braking");
   p.torque_lost_braking_threshold = t.number("lost_braking_threshold", Range{0.0, 1.0, true, true});
+  p.torque_loss_braking_threshold = t.number("loss_braking_threshold", Range{0.0, 1.0, true, true});
   p.torque_after_resolver_offset = t.boolean("after_resolver_offset");
   p.torque_stop_margin_rev = t.number("stop_margin_rev", config::Range::non_negative());
   p.unexplained_margin_Nm = t.number("unexplained_margin_Nm", pos);

@@ -96,14 +96,27 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // motor crosses the gap carrying none of the load (the spindle's own friction holds it: tuning
   // seed 1401 run 57, a healthy corner backing off at 29 kN): the lost verdict takes whichever of
   // the two needs, with the load or without, makes the drive the less lost.
-  const bool braking = load_cell_load && p.torque_lost_braking && p.torque_check_moving_min_speed_rev_per_s > 0.0 &&
-                       std::abs(make_Nm_) >= p.torque_check_min_torque_Nm && make_Nm_ * r.speed_rev_per_s < 0.0 &&
-                       std::abs(r.speed_rev_per_s) >= p.torque_check_moving_min_speed_rev_per_s;
+  const bool braking_at_speed = load_cell_load && p.torque_check_moving_min_speed_rev_per_s > 0.0 &&
+                                std::abs(make_Nm_) >= p.torque_check_min_torque_Nm && make_Nm_ * r.speed_rev_per_s < 0.0 &&
+                                std::abs(r.speed_rev_per_s) >= p.torque_check_moving_min_speed_rev_per_s;
+  const bool braking = braking_at_speed && p.torque_lost_braking;
   const double carried_Nm = p.eol_backlash_rev > 0.0 ? std::max(0.0, load_kN) * p.Nm_per_kN : 0.0;
-  const bool lost_braking =
-      braking && std::max((need_Nm_ + friction_Nm_) / make_Nm_, (need_Nm_ - carried_Nm + friction_Nm_) / make_Nm_) /
-                         motor_scale_ <
-                     p.torque_lost_braking_threshold;
+  // The torque-loss verdict braking, and applying below the moving check's load, takes the larger
+  // plausible load (the end-of-line curve's with its band, when the position is known): at a low
+  // load, and braking (the need less the friction), a load cell that reads low looks like a weak
+  // motor (a -2 kN bias read 0.58 releasing at 7 kN).
+  const bool plausible = eol_.has_value() && position_known;
+  const double need_judged_Nm = plausible ? std::max(need_Nm_, need_hi_Nm_) : need_Nm_;
+  const double braking_fraction =
+      !braking_at_speed ? 1.0
+                        : std::max((need_Nm_ + friction_Nm_) / make_Nm_, (need_Nm_ - carried_Nm + friction_Nm_) / make_Nm_);
+  const double braking_judged_fraction =
+      !braking_at_speed ? 1.0 : std::max(braking_fraction, (need_judged_Nm + friction_Nm_) / make_Nm_);
+  const bool applying_low = applying && plausible && p.torque_check_moving_low_load_kN > 0.0 &&
+                            load_kN >= p.torque_check_moving_low_load_kN && load_kN < p.torque_check_moving_min_load_kN &&
+                            make_Nm_ >= p.torque_check_min_torque_Nm;
+  const double applying_low_fraction = applying_low ? (need_judged_Nm + friction_Nm_) / make_Nm_ : 1.0;
+  const bool lost_braking = braking && braking_fraction / motor_scale_ < p.torque_lost_braking_threshold;
   // The lost verdicts only once the filters have settled (kSettledTimeConstants of
   // torque_filter_s since they started): at a rejoin the acceleration is unknown, the need starts
   // at the load alone and lags the drive's motion (realtime system test
@@ -173,14 +186,23 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
     unexplained_suspect_ = false;
   }
   const bool still = std::abs(r.speed_rev_per_s) <= p.torque_check_max_speed_rev_per_s;
-  if (checkable && (still || applying) && judged_fraction < p.torque_fraction_threshold && !winding_up) {
+  const bool weak_still_or_applying = checkable && (still || applying) && judged_fraction < p.torque_fraction_threshold;
+  const bool weak_braking = braking_at_speed &&
+                            load_kN >= (plausible && p.torque_check_moving_low_load_kN > 0.0 ? p.torque_check_moving_low_load_kN
+                                                                                             : p.torque_check_moving_min_load_kN) &&
+                            braking_judged_fraction < p.torque_loss_braking_threshold;
+  const bool weak_applying_low = applying_low && applying_low_fraction < p.torque_fraction_threshold;
+  if ((weak_still_or_applying || weak_braking || weak_applying_low) && !winding_up) {
     if (!torque_suspect_) {
       torque_suspect_ = true;
       torque_onset_s_ = t;
     }
     if (t - torque_onset_s_ >= p.torque_persist_s) {
       a.confirm(Finding::ActuatorTorqueLoss, torque_onset_s_, t);
-      rescale_after_torque_loss(judged_fraction, p, a);
+      rescale_after_torque_loss(weak_still_or_applying ? judged_fraction
+                                : weak_braking          ? braking_judged_fraction
+                                                        : applying_low_fraction,
+                                p, a);
     }
   } else {
     torque_suspect_ = false;

@@ -273,6 +273,12 @@ struct MonitorParams {
   // reading b kN low gives the fraction 1 - b / (load + friction / Nm_per_kN), which stays above
   // torque_fraction_threshold for biases up to the largest the campaigns draw).
   double torque_check_moving_min_load_kN = 4.0;
+  // From this load up to torque_check_moving_min_load_kN the torque-loss rule judges applying
+  // too, and braking from here, both with the larger plausible load (the end-of-line curve's with
+  // its band, where the position is known) so that a load cell reading low is not a weak motor
+  // (twentieth session: a 66 % loss in a slow apply named at 4 kN, 1.035 s after it; tuning seed
+  // 1403 run 72). 0: the moving checks from torque_check_moving_min_load_kN only.
+  double torque_check_moving_low_load_kN = 2.0;
   double torque_persist_s = 0.04;
   double torque_lost_threshold = 0.25;        // at any speed, below this: the actuator is lost
   double torque_lost_persist_s = 0.015;
@@ -302,6 +308,12 @@ struct MonitorParams {
   // inertia term, and a 74 % loss read 0.2-0.26 there (scoring seed 1402 run 1751, named lost);
   // a motor without torque reads about 0.
   double torque_lost_braking_threshold = 0.15;
+  // The torque-loss rule while the motor brakes the rotor at speed too (twentieth session): the
+  // same balance as lost_braking's, from torque_check_moving_min_load_kN of the load cell's load,
+  // below this fraction. A drive released slowly under load holds the screw back against the
+  // load (less its friction); a weaker motor needs proportionally more current for it (tuning
+  // seed 1406 run 112: a 59 % loss at 7 kN in a slow release, named only after it ended). 0: off.
+  double torque_loss_braking_threshold = 0.6;
   // The torque rules go on after a resolver is named offset: its speed is still the rotor's (an
   // offset moves the position only), and its position, less the offset, while compensated
   // (resolver_jump.compensate). Tuning seed 1403 run 780: a total loss 0.1 s after a resolver

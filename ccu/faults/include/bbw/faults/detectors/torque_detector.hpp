@@ -2,8 +2,8 @@
 // load * Nm_per_kN + J 2 pi a, against the torque the measured current should make,
 // i * torque_per_A; both low-pass filtered, their ratio is the delivered torque fraction. Below
 // torque_lost_threshold at any speed: ActuatorLost; below torque_fraction_threshold at
-// standstill, or applying at speed with the drive's friction added to the need:
-// ActuatorTorqueLoss. Near standstill at any load, a made torque that neither the
+// standstill, or at speed with the drive's friction added to the need (applying, or braking a
+// release: MonitorParams::torque_loss_braking_threshold): ActuatorTorqueLoss. Near standstill at any load, a made torque that neither the
 // load cell's load nor the end-of-line curve's (with its band), the acceleration and the drive's
 // friction explain, and of which less than torque_lost_threshold would be needed
 // (MonitorParams::unexplained_*): ActuatorLost. A load-cell fault moves only one of the two
