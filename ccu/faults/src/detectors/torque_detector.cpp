@@ -124,7 +124,12 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // -4 rev/s in the outage's own release, seen as its link returned, was named lost 7 ms after
   // the filters started).
   const bool settled = r.time_s - torque_since_s_ >= kSettledTimeConstants * p.torque_filter_s;
-  if (settled && ((checkable && judged_fraction / motor_scale_ < p.torque_lost_threshold) || lost_braking)) {
+  // Applying below the moving check's load, judged with the larger plausible load, the lost
+  // threshold holds as above it: a drive with a fifth of its torque left, accelerating at its
+  // current limit into a hard stop, is lost, not a torque loss kept in use (tuning seed 1403 run
+  // 374: a 79 % loss named a torque loss, then not tracking 12 s later).
+  const bool lost_applying_low = applying_low && applying_low_fraction / motor_scale_ < p.torque_lost_threshold;
+  if (settled && ((checkable && judged_fraction / motor_scale_ < p.torque_lost_threshold) || lost_applying_low || lost_braking)) {
     if (!lost_suspect_) {
       lost_suspect_ = true;
       lost_onset_s_ = t;
@@ -197,7 +202,10 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
       torque_suspect_ = true;
       torque_onset_s_ = t;
     }
-    if (t - torque_onset_s_ >= p.torque_persist_s) {
+    // Not while a lost verdict is pending (lost_persist_s): a drive whose torque fraction is below
+    // the lost threshold is lost, and a torque loss named first would keep it in use (the lost
+    // rules then judge the drive that is left: tuning seed 1403 run 374, a 79 % loss).
+    if (t - torque_onset_s_ >= p.torque_persist_s && !lost_suspect_) {
       a.confirm(Finding::ActuatorTorqueLoss, torque_onset_s_, t);
       rescale_after_torque_loss(weak_still_or_applying ? judged_fraction
                                 : weak_braking          ? braking_judged_fraction
