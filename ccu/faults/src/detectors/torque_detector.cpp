@@ -104,7 +104,7 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // The torque-loss verdict braking, and applying below the moving check's load, takes the larger
   // plausible load (the end-of-line curve's with its band, when the position is known): at a low
   // load, and braking (the need less the friction), a load cell that reads low looks like a weak
-  // motor (a -2 kN bias read 0.58 releasing at 7 kN).
+  // motor (computed: a load cell 2 kN low reads 0.57 while the motor holds back a release at 6 kN).
   const bool plausible = eol_.has_value() && position_known;
   const double need_judged_Nm = plausible ? std::max(need_Nm_, need_hi_Nm_) : need_Nm_;
   const double braking_fraction =

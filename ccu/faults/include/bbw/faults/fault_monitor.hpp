@@ -309,8 +309,9 @@ struct MonitorParams {
   // a motor without torque reads about 0.
   double torque_lost_braking_threshold = 0.15;
   // The torque-loss rule while the motor brakes the rotor at speed too (twentieth session): the
-  // same balance as lost_braking's, from torque_check_moving_min_load_kN of the load cell's load,
-  // below this fraction. A drive released slowly under load holds the screw back against the
+  // same balance as lost_braking's, from torque_check_moving_min_load_kN of the load cell's load
+  // (from torque_check_moving_low_load_kN with the end-of-line curve, its larger plausible load
+  // judged), below this fraction. A drive released slowly under load holds the screw back against the
   // load (less its friction); a weaker motor needs proportionally more current for it (tuning
   // seed 1406 run 112: a 59 % loss at 7 kN in a slow release, named only after it ended). 0: off.
   double torque_loss_braking_threshold = 0.6;

@@ -3,7 +3,9 @@
 // i * torque_per_A; both low-pass filtered, their ratio is the delivered torque fraction. Below
 // torque_lost_threshold at any speed: ActuatorLost; below torque_fraction_threshold at
 // standstill, or at speed with the drive's friction added to the need (applying, or braking a
-// release: MonitorParams::torque_loss_braking_threshold): ActuatorTorqueLoss. Near standstill at any load, a made torque that neither the
+// release: MonitorParams::torque_loss_braking_threshold; below the moving check's load with the
+// larger plausible load, MonitorParams::torque_check_moving_low_load_kN): ActuatorTorqueLoss.
+// Near standstill at any load, a made torque that neither the
 // load cell's load nor the end-of-line curve's (with its band), the acceleration and the drive's
 // friction explain, and of which less than torque_lost_threshold would be needed
 // (MonitorParams::unexplained_*): ActuatorLost. A load-cell fault moves only one of the two
