@@ -522,22 +522,34 @@ TEST(FaultMonitor, TorqueBalanceSeparatesPartialAndTotalLoss) {
 // kN (below the standstill check's minimum load), a healthy one is not, nor a load cell 2 kN low,
 // nor the same loss while releasing (the load back-drives the screw); with the moving check off
 // it waits for a hold at a higher load.
+namespace {
+
+// A drive moving at `speed_rev_per_s` from `x0_rev` for 0.2 s on a 2 kN/rev slope (no curve), its
+// true load from `true_kN`, its load cell from `lc_kN`, with the current a drive making `fraction`
+// of its torque needs; the actuator's diagnosis (the sensors must stay trusted).
+Diagnosis drive_at_speed(const MonitorParams& p, double x0_rev, double fraction, double speed_rev_per_s, double true_kN,
+                         double lc_kN) {
+  SampleCheck ok;
+  FaultMonitor m(p, Target::FL);
+  const double friction_Nm = bbw::plant::drive_friction_Nm(p.drive, speed_rev_per_s);
+  for (int k = 1; k < 200; ++k) {
+    const double t = 0.001 * k;
+    const double rise_kN = 2.0 * speed_rev_per_s * t;  // 2 kN/rev
+    auto r = at(k, t, x0_rev + speed_rev_per_s * t, lc_kN + rise_kN);
+    r.speed_rev_per_s = speed_rev_per_s + (k % 2 == 0 ? 1e-4 : -1e-4);  // a real speed never repeats exactly
+    r.motor_current_A = ((true_kN + rise_kN) * p.Nm_per_kN + friction_Nm) / (p.torque_per_A_Nm * fraction);
+    m.update(r, ok, nullptr, r.force_kN, t);
+  }
+  EXPECT_TRUE(m.ok(Part::LoadCell) && m.ok(Part::Resolver));
+  return m.diagnosis(Part::Actuator);
+}
+
+}  // namespace
+
 TEST(FaultMonitor, ATorqueLossIsNamedDuringAnApplyBelowTheHoldChecksLoad) {
   MonitorParams base = noiseless();
-  SampleCheck ok;
-  auto run = [&](const MonitorParams& p, double fraction, double speed_rev_per_s, double true_kN, double lc_kN) {
-    FaultMonitor m(p, Target::FL);
-    const double friction_Nm = bbw::plant::drive_friction_Nm(p.drive, speed_rev_per_s);
-    for (int k = 1; k < 200; ++k) {
-      const double t = 0.001 * k;
-      const double rise_kN = 2.0 * speed_rev_per_s * t;  // 2 kN/rev
-      auto r = at(k, t, 2.0 + speed_rev_per_s * t, lc_kN + rise_kN);
-      r.speed_rev_per_s = speed_rev_per_s + (k % 2 == 0 ? 1e-4 : -1e-4);  // a real speed never repeats exactly
-      r.motor_current_A = ((true_kN + rise_kN) * p.Nm_per_kN + friction_Nm) / (p.torque_per_A_Nm * fraction);
-      m.update(r, ok, nullptr, r.force_kN, t);
-    }
-    EXPECT_TRUE(m.ok(Part::LoadCell) && m.ok(Part::Resolver));
-    return m.diagnosis(Part::Actuator);
+  auto run = [](const MonitorParams& p, double fraction, double speed_rev_per_s, double true_kN, double lc_kN) {
+    return drive_at_speed(p, 2.0, fraction, speed_rev_per_s, true_kN, lc_kN);
   };
   ASSERT_LT(5.0, base.torque_check_min_load_kN);
   ASSERT_GE(5.0, base.torque_check_moving_min_load_kN);
@@ -557,20 +569,8 @@ TEST(FaultMonitor, ATorqueLossIsNamedDuringAnApplyBelowTheHoldChecksLoad) {
 // seed 1406 run 112: a 59 % loss in a slow release at 7 kN, found only after it had ended).
 TEST(FaultMonitor, ATorqueLossIsNamedWhileTheMotorHoldsBackARelease) {
   MonitorParams base = noiseless();
-  SampleCheck ok;
-  auto run = [&](const MonitorParams& p, double fraction, double speed_rev_per_s, double true_kN, double lc_kN) {
-    FaultMonitor m(p, Target::FL);
-    const double friction_Nm = bbw::plant::drive_friction_Nm(p.drive, speed_rev_per_s);
-    for (int k = 1; k < 200; ++k) {
-      const double t = 0.001 * k;
-      const double rise_kN = 2.0 * speed_rev_per_s * t;  // 2 kN/rev
-      auto r = at(k, t, 3.0 + speed_rev_per_s * t, lc_kN + rise_kN);
-      r.speed_rev_per_s = speed_rev_per_s + (k % 2 == 0 ? 1e-4 : -1e-4);  // a real speed never repeats exactly
-      r.motor_current_A = ((true_kN + rise_kN) * p.Nm_per_kN + friction_Nm) / (p.torque_per_A_Nm * fraction);
-      m.update(r, ok, nullptr, r.force_kN, t);
-    }
-    EXPECT_TRUE(m.ok(Part::LoadCell) && m.ok(Part::Resolver));
-    return m.diagnosis(Part::Actuator);
+  auto run = [](const MonitorParams& p, double fraction, double speed_rev_per_s, double true_kN, double lc_kN) {
+    return drive_at_speed(p, 3.0, fraction, speed_rev_per_s, true_kN, lc_kN);
   };
   ASSERT_GT(0.0, bbw::plant::drive_friction_Nm(base.drive, -1.5));  // the friction helps the motor hold back
   EXPECT_FALSE(run(base, 1.0, -1.5, 7.0, 7.0).present);
