@@ -524,6 +524,13 @@ TEST(FaultMonitor, TorqueBalanceSeparatesPartialAndTotalLoss) {
 // it waits for a hold at a higher load.
 namespace {
 
+// The position (0.5-10 rev) where `curve` makes `force_kN` at `temperature_C`, unworn (bisection).
+double position_on(const bbw::plant::ClampCurve& curve, double temperature_C, double force_kN) {
+  double lo = 0.5, hi = 10.0;
+  for (int i = 0; i < 60; ++i) ((curve.force_kN(0.5 * (lo + hi), temperature_C, 0.0) < force_kN) ? lo : hi) = 0.5 * (lo + hi);
+  return 0.5 * (lo + hi);
+}
+
 // A drive moving at `speed_rev_per_s` from `x0_rev` for 0.2 s on a 2 kN/rev slope (no curve), its
 // true load from `true_kN`, its load cell from `lc_kN`, with the current a drive making `fraction`
 // of its torque needs; the actuator's diagnosis (the sensors must stay trusted).
@@ -840,11 +847,7 @@ TEST(FaultMonitor, ATorqueLossBelowTheMovingChecksLoadIsJudgedWithTheLargerPlaus
   p.eol_friction_half_width_kN = 1.0;
   const bbw::plant::ClampCurve eol{*p.eol_curve};
   const double T = p.eol_curve->reference_temperature_C;
-  auto position_of = [&](double force_kN) {
-    double lo = 0.5, hi = 10.0;
-    for (int i = 0; i < 60; ++i) ((eol.force_kN(0.5 * (lo + hi), T, 0.0) < force_kN) ? lo : hi) = 0.5 * (lo + hi);
-    return 0.5 * (lo + hi);
-  };
+  auto position_of = [&](double force_kN) { return position_on(eol, T, force_kN); };
   SampleCheck ok;
   // From the position of `true_kN` at `speed`, the load cell `offset_kN` off the curve, the
   // current a drive with `fraction` of its torque needs.
@@ -900,9 +903,7 @@ TEST(FaultMonitor, ASeizedDriveInAHoldWindsItsCurrentUpAndIsLostNotATorqueLoss) 
   p.eol_friction_half_width_kN = 1.0;
   const bbw::plant::ClampCurve eol{*p.eol_curve};
   const double T = p.eol_curve->reference_temperature_C;
-  double lo = 0.5, hi = 10.0;  // the position of 21.5 kN on the end-of-line curve
-  for (int i = 0; i < 60; ++i) ((eol.force_kN(0.5 * (lo + hi), T, 0.0) < 21.5) ? lo : hi) = 0.5 * (lo + hi);
-  const double x = 0.5 * (lo + hi);
+  const double x = position_on(eol, T, 21.5);  // the position of 21.5 kN on the end-of-line curve
   SampleCheck ok;
   struct Seen {
     Diagnosis actuator;

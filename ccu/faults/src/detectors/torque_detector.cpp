@@ -112,9 +112,11 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
                         : std::max((need_Nm_ + friction_Nm_) / make_Nm_, (need_Nm_ - carried_Nm + friction_Nm_) / make_Nm_);
   const double braking_judged_fraction =
       !braking_at_speed ? 1.0 : std::max(braking_fraction, (need_judged_Nm + friction_Nm_) / make_Nm_);
-  const bool applying_low = applying && plausible && p.torque_check_moving_low_load_kN > 0.0 &&
-                            load_kN >= p.torque_check_moving_low_load_kN && load_kN < p.torque_check_moving_min_load_kN &&
-                            make_Nm_ >= p.torque_check_min_torque_Nm;
+  // The moving checks' least load: from torque_check_moving_low_load_kN where the curve gives the larger load.
+  const bool low_load = plausible && p.torque_check_moving_low_load_kN > 0.0;
+  const double moving_min_load_kN = low_load ? p.torque_check_moving_low_load_kN : p.torque_check_moving_min_load_kN;
+  const bool applying_low = applying && low_load && load_kN >= moving_min_load_kN &&
+                            load_kN < p.torque_check_moving_min_load_kN && make_Nm_ >= p.torque_check_min_torque_Nm;
   const double applying_low_fraction = applying_low ? (need_judged_Nm + friction_Nm_) / make_Nm_ : 1.0;
   const bool lost_braking = braking && braking_fraction / motor_scale_ < p.torque_lost_braking_threshold;
   // The lost verdicts only once the filters have settled (kSettledTimeConstants of
@@ -192,10 +194,8 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   }
   const bool still = std::abs(r.speed_rev_per_s) <= p.torque_check_max_speed_rev_per_s;
   const bool weak_still_or_applying = checkable && (still || applying) && judged_fraction < p.torque_fraction_threshold;
-  const bool weak_braking = braking_at_speed &&
-                            load_kN >= (plausible && p.torque_check_moving_low_load_kN > 0.0 ? p.torque_check_moving_low_load_kN
-                                                                                             : p.torque_check_moving_min_load_kN) &&
-                            braking_judged_fraction < p.torque_loss_braking_threshold;
+  const bool weak_braking =
+      braking_at_speed && load_kN >= moving_min_load_kN && braking_judged_fraction < p.torque_loss_braking_threshold;
   const bool weak_applying_low = applying_low && applying_low_fraction < p.torque_fraction_threshold;
   if ((weak_still_or_applying || weak_braking || weak_applying_low) && !winding_up) {
     if (!torque_suspect_) {

@@ -10,7 +10,8 @@ namespace bbw::faults {
 void UnpoweredHoldDetector::update(const SampleContext& c, bool commutation_lost, const MonitorParams& p,
                                    DiagnosisArbiter& a) {
   const CornerReading& r = c.r;
-  const bool unpowered = p.unpowered_hold && commutation_lost && a.ok(Part::LoadCell) && c.check.load_cell_present && std::isfinite(r.force_kN) &&
+  const bool unpowered = p.unpowered_hold && commutation_lost && a.ok(Part::LoadCell) && c.check.load_cell_present &&
+                         std::isfinite(r.force_kN) &&
                          std::isfinite(r.motor_current_A) && std::abs(r.motor_current_A) <= p.unpowered_max_current_A &&
                          std::abs(r.speed_rev_per_s) <= p.unpowered_max_speed_rev_per_s && c.have_prev &&
                          c.dt_s <= p.jump_max_gap_s;
