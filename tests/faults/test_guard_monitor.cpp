@@ -1428,6 +1428,7 @@ TEST(FaultMonitor, ASlowDriftCannotWidenTheLearntThresholdAsFastAsItGrows) {
   auto run = [](double clip, double drift_kN_per_s) {
     MonitorParams p = eol_params(1.5, false);
     p.hold_calibrated = false;  // the residual rule alone
+    p.revisit = false;          // (the revisit rule, twenty-first session, names this drift at 12.77 s)
     p.residual_stats_clip = clip;
     p.eol_relative = kEolRelativeUntilSession16;
     EolCaliper caliper{p};
@@ -1496,6 +1497,7 @@ TEST(FaultMonitor, AHoldCarriesADriftsChangeAcrossTheFirstFit) {
   auto run = [](bool rebase, double drift_kN_per_s) {
     MonitorParams p = eol_params(1.5, false);
     p.hold_rebase = rebase;
+    p.revisit = false;  // the hold rule alone (the revisit rule, twenty-first session, names it at 5.15 s)
     p.eol_relative = kEolRelativeUntilSession16;
     // The first fit comes at 5 s, in the hold; before it, the load cell as it is.
     return drift_in_a_hold(p, drift_kN_per_s, [](double t, double lc, double friction_kN, double curve_kN) {
@@ -1521,6 +1523,9 @@ TEST(FaultMonitor, CalibratedAHoldKeepsItsLevelWhileTheLearntStatisticsFollowADr
     p.eol_relative = kEolRelativeUntilSession16;  // with 1 % the capped thresholds alone: 5.93 s
     p.hold_calibrated = hold_calibrated;
     p.residual_stats_prior_s = prior_s;
+    // The hold rule and the learnt statistics alone: the revisit rule (twenty-first session)
+    // names this drift by itself too (5.15 s), where the hold began.
+    p.revisit = false;
     // Calibrated from 0.5 s, its friction right.
     return drift_in_a_hold(p, drift_kN_per_s, [](double t, double lc, double friction_kN, double curve_kN) {
       return fitted(t > 0.5, lc, friction_kN, curve_kN);
@@ -1543,6 +1548,55 @@ TEST(FaultMonitor, CalibratedAHoldKeepsItsLevelWhileTheLearntStatisticsFollowADr
   EXPECT_EQ(learnt.finding, Finding::LoadCellOffset) << to_string(learnt.finding);
   EXPECT_LT(learnt.detected_s, window_end_s);
   EXPECT_FALSE(run(false, 0.0, running).present);
+}
+
+// The revisit rule: a calibrated corner modulated like an ABS (6 Hz, +-0.15 rev about 4.5 rev)
+// whose clamp curve is 3 % stiffer than its end-of-line one (within the band, but 0.6 kN of it at
+// 20 kN), its calibrator right about the friction. A -1 kN/s load-cell drift from 4 s: at speed
+// the level rule's allowance grows by 0.3 kN per rev/s and the residual starts 0.6 kN up, so the
+// level rule finds the drift only after its window (4 s + 1 kN / 1 kN/s + 0.5 s); where the
+// drive has been before, the residual has kept its level within 0.1 kN, and the drift shows
+// there from about 0.6 kN.
+TEST(FaultMonitor, TheRevisitRuleFindsADriftWhereTheDriveHasBeenBefore) {
+  auto run = [](bool revisit, double drift_kN_per_s) {
+    MonitorParams p = eol_params(1.5, false);
+    p.revisit = revisit;
+    EolCaliper caliper{p};
+    auto& [eol, keys, T] = caliper;
+    FaultMonitor m(p, Target::FR);
+    SampleGuard g{MonitorParams{}.guard};
+    double x = 0.0;
+    for (int n = 1; n < 7000; ++n) {
+      const double t = 0.001 * n;
+      const double w = 2.0 * M_PI * 6.0;
+      double speed = 4.5;
+      if (t >= 1.0) speed = 0.15 * w * std::cos(w * (t - 1.0));
+      x = t < 1.0 ? 4.5 * t : 4.5 + 0.15 * std::sin(w * (t - 1.0));
+      const double friction_kN = keys.step(x);
+      const double drift_kN = t > 4.0 ? drift_kN_per_s * (t - 4.0) : 0.0;
+      const double clamp_kN = 1.03 * eol.force_kN(x, T, 0.0);
+      const double lc = clamp_kN + friction_kN + drift_kN + 0.03 * ((n % 5) - 2);
+      const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
+      const auto e = fitted(t > 0.5, lc, friction_kN, clamp_kN);
+      m.update(r, g.check(r), &e, e.force_kN, t);
+    }
+    return m.diagnosis(Part::LoadCell);
+  };
+  const double window_end_s = 4.0 + 1.0 / 1.0 + 0.5;
+  const auto healthy = run(true, 0.0);
+  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
+  const auto without = run(false, -1.0);
+  EXPECT_TRUE(!without.present || without.detected_s > window_end_s) << without.detected_s;
+  const auto with = run(true, -1.0);
+  EXPECT_EQ(with.finding, Finding::LoadCellOffset) << to_string(with.finding);
+  EXPECT_GT(with.detected_s, 4.0);
+  EXPECT_LT(with.detected_s, window_end_s);
+  // A drift the other way, too.
+  const auto up = run(true, 1.0);
+  EXPECT_EQ(up.finding, Finding::LoadCellOffset) << to_string(up.finding);
+  EXPECT_LT(up.detected_s, window_end_s);
+  std::printf("revisit rule: drift -1 kN/s from 4 s named at %.3f s (without it: %s %.3f s), +1 kN/s at %.3f s\n",
+              with.detected_s, without.present ? "named at" : "not named;", without.detected_s, up.detected_s);
 }
 
 // The lost rules judge a drive only once its torque filters have settled (three filter time

@@ -40,6 +40,10 @@ void MonitorParams::validate() const {
   positive("hold_span_rev", hold_span_rev);
   positive("hold_span_known_rev", hold_span_known_rev);
   require(hold_settle_samples >= 1, "hold_settle_samples", hold_settle_samples, "must be >= 1");
+  positive("revisit_kN", revisit_kN);
+  positive("revisit_bin_rev", revisit_bin_rev);
+  require(revisit_settle_samples >= 1, "revisit_settle_samples", revisit_settle_samples, "must be >= 1");
+  positive("revisit_forget_s", revisit_forget_s);
   require(std::isfinite(eol_backlash_rev) && eol_backlash_rev >= 0.0, "eol_backlash_rev", eol_backlash_rev, "must be >= 0");
   require(std::isfinite(eol_friction_model_share) && eol_friction_model_share >= 0.0 && eol_friction_model_share <= 1.0,
           "eol_friction_model_share", eol_friction_model_share, "must be in [0, 1]");

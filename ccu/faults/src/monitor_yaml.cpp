@@ -55,6 +55,15 @@ MonitorParams read_monitor_params(Reader& r) {
     p.hold_rebase = h.boolean("rebase");
     h.finish();
   }
+  {
+    auto v = res.map("revisit");
+    p.revisit = v.boolean("enabled");
+    p.revisit_kN = v.number("kN", pos);
+    p.revisit_bin_rev = v.number("bin_rev", pos);
+    p.revisit_settle_samples = static_cast<int>(v.integer("settle_samples", 1, 100000));
+    p.revisit_forget_s = v.number("forget_s", pos);
+    v.finish();
+  }
   p.residual_low_upper_bound = res.boolean("low_upper_bound");
   p.residual_low_lower_bound = res.boolean("low_lower_bound");
   p.residual_low_static_span_rev = res.number("low_static_span_rev", config::Range::non_negative());

@@ -27,6 +27,11 @@ ResidualDetector::ResidualDetector(const MonitorParams& p)
     const double phi = std::exp(-0.5 * c * c) / std::sqrt(2.0 * M_PI);
     stats_clip_moment_ = (1.0 - tail) - 2.0 * c * phi + c * c * tail;
   }
+  if (p.revisit) {
+    revisit_min_rev_ = p.curve_min_rev;
+    revisit_per_class_ = std::max(1, static_cast<int>(std::ceil((p.curve_max_rev - p.curve_min_rev) / p.revisit_bin_rev)));
+    revisit_bins_.resize(kRevisitClasses * static_cast<std::size_t>(revisit_per_class_));
+  }
   if (p.eol_curve) eol_.emplace(*p.eol_curve);
   if (p.eol_curve && p.eol_key_friction) {
     plant::KeyFrictionParams k = *p.eol_key_friction;
@@ -34,6 +39,7 @@ ResidualDetector::ResidualDetector(const MonitorParams& p)
     eol_friction_.emplace(k);
     std::get<0>(saved_) = eol_friction_;  // the saved state's storage, made once
     sweep_rev_ = 2.0 * eol_friction_->thresholds_rev().back();
+    eol_friction_half_width_kN_ = eol_friction_->half_width_kN();
   }
 }
 
@@ -56,6 +62,46 @@ void ResidualDetector::track_position(const CornerReading& r, const MonitorParam
   x_max_rev_ = std::max(x_max_rev_, r.position_rev);
   const double sweep_rev = sweep_rev_ + p.eol_backlash_rev;
   if (r.position_rev - x_min_rev_ >= sweep_rev || x_max_rev_ - r.position_rev >= sweep_rev) friction_known_ = true;
+}
+
+int ResidualDetector::judge_revisit(const CornerReading& r, double eol_keys_kN, bool& over, const MonitorParams& p) {
+  revisit_change_kN_ = std::numeric_limits<double>::quiet_NaN();
+  revisit_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
+  revisit_kN_ = std::numeric_limits<double>::quiet_NaN();
+  // Its own residual, one definition from the friction model's state on: the load cell against
+  // the end-of-line curve and friction model where the keys are (the calibrator's friction and
+  // its fits change from cycle to cycle; this does not). Before that state is known the residual
+  // holds the key friction's whole width wherever it happens to be: no level to come back to.
+  if (revisit_bins_.empty() || !eol_ || !friction_known_ || !std::isfinite(r.force_kN)) return -1;
+  revisit_kN_ = r.force_kN - eol_keys_kN - eol_friction_kN_;
+  const int i = static_cast<int>(std::floor((r.position_rev - revisit_min_rev_) / p.revisit_bin_rev));
+  if (i < 0 || i >= revisit_per_class_) return -1;
+  // The motion (up, down, slower than a hold either way) and the keys' state: slipping all one
+  // way (the model's friction within 2 % of its half-width) or between (after a reversal): there
+  // the model's error depends on where the reversal was, not only on the position.
+  const int direction = r.speed_rev_per_s > p.hold_speed_rev_per_s ? 0 : r.speed_rev_per_s < -p.hold_speed_rev_per_s ? 1 : 2;
+  const bool between = std::abs(eol_friction_kN_) < 0.98 * eol_friction_half_width_kN_;
+  const int motion = 2 * direction + (between ? 1 : 0);
+  const int bin = motion * revisit_per_class_ + i;
+  const RevisitBin& b = revisit_bins_[static_cast<std::size_t>(bin)];
+  if (b.n >= p.revisit_settle_samples) {
+    revisit_change_kN_ = revisit_kN_ - b.level_kN;
+    // Between, the model knows the keys' friction within its share of the width.
+    const double friction_kN = between ? p.eol_friction_model_share * p.eol_friction_half_width_kN : 0.0;
+    revisit_threshold_kN_ =
+        eol_allowance_kN(p, p.revisit_kN, friction_kN, 0.0, r.speed_rev_per_s - b.speed_rev_per_s);
+    over = std::abs(revisit_change_kN_) > revisit_threshold_kN_;
+  }
+  return bin;
+}
+
+void ResidualDetector::learn_revisit(int bin, double speed_rev_per_s, double dt_s, const MonitorParams& p) {
+  if (bin < 0) return;
+  RevisitBin& b = revisit_bins_[static_cast<std::size_t>(bin)];
+  const double w = b.n < p.revisit_settle_samples ? 1.0 / (b.n + 1) : -std::expm1(-dt_s / p.revisit_forget_s);
+  if (b.n < p.revisit_settle_samples) ++b.n;
+  b.level_kN += (revisit_kN_ - b.level_kN) * w;
+  b.speed_rev_per_s += (speed_rev_per_s - b.speed_rev_per_s) * w;
 }
 
 bool ResidualDetector::static_changed(const CornerReading& r, double curve_kN, const MonitorParams& p) {
@@ -87,6 +133,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
                               DiagnosisArbiter& a, NoiseDetector& noise, const StuckDetector& stuck,
                               const JumpDetector& jump) {
   const double t = r.time_s;
+  const double revisit_dt_s = std::max(0.0, t - revisit_time_s_);  // a bin learns the time spent in it
+  revisit_time_s_ = t;
   residual_kN_ = e.force_kN - e.curve_force_kN;
   // The end-of-line curve where the keys and pads are (the spindle, once the friction model's
   // state is known; else the motor) at the measured temperature: evaluated once per sample for
@@ -325,8 +373,11 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   hold_last_kN_ = slow ? residual_kN_ : std::numeric_limits<double>::quiet_NaN();
   hold_last_x_rev_ = x_hold;
   hold_last_curve_kN_ = hold_curve_kN;
-  const bool over = p.residual_findings &&
-                    (std::abs(residual_kN_) > thr || (change_rule && std::abs(change_kN_) > change_thr) || hold_over);
+  bool revisit_over = false;
+  const int revisit_bin = judge_revisit(r, eol_keys_kN, revisit_over, p);
+  const bool over = p.residual_findings && (std::abs(residual_kN_) > thr ||
+                                            (change_rule && std::abs(change_kN_) > change_thr) || hold_over || revisit_over);
+  learn_revisit(over ? -1 : revisit_bin, r.speed_rev_per_s, revisit_dt_s, p);
   if (!over && !eol_here && e.calibrated && std::isfinite(ms_residual_kN2_) && std::isfinite(change_kN_)) {
     // Healthy: the corner's own residual statistics follow (never while suspected).
     // A running mean of the start (weighing residual_stats_prior_s) and the samples until they

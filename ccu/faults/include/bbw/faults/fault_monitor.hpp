@@ -115,6 +115,18 @@ struct MonitorParams {
   // A settled hold carries its change across a change of the residual's definition or a new
   // fit (its reference moves by the residual's jump between two samples) instead of restarting.
   bool hold_rebase = true;
+  // Revisit rule: where the drive has been before (a position bin of revisit_bin_rev, moving up,
+  // moving down or slower than hold_speed_rev_per_s), the residual keeps the level it had there:
+  // the curve and the friction are the same there, a load-cell drift is not. A bin's level is the
+  // mean of its first revisit_settle_samples healthy residuals, then low-passed over
+  // revisit_forget_s of time spent in it. A change beyond revisit_kN + eol_speed x the speed's
+  // change from the bin's (+ the friction model's share of the width when slow) is a
+  // disagreement. The bins start again whenever the residual's definition changes.
+  bool revisit = true;
+  double revisit_kN = 0.6;
+  double revisit_bin_rev = 0.05;
+  int revisit_settle_samples = 5;
+  double revisit_forget_s = 20.0;
   double eol_band_kN = 0.5;
   // The end-of-line test's accuracy, relative to the force: its reference load cell and the
   // temperature compensation (1 %; in simulation the end-of-line curve is the plant's own, so
@@ -453,6 +465,8 @@ class FaultMonitor {
   // The hold rule's change since its hold settled and its allowance (kN; NaN outside a hold).
   double last_hold_change_kN() const { return residual_.hold_change_kN(); }
   double last_hold_threshold_kN() const { return residual_.hold_threshold_kN(); }
+  double last_revisit_change_kN() const { return residual_.revisit_change_kN(); }
+  double last_revisit_threshold_kN() const { return residual_.revisit_threshold_kN(); }
   // A residual disagreement is under way but not yet confirmed: the calibrator must not learn
   // from these samples (CornerSupervisor holds its fits).
   bool residual_suspect() const { return residual_.suspect(); }

@@ -12,6 +12,7 @@
 #include <limits>
 #include <optional>
 #include <tuple>
+#include <vector>
 
 #include "bbw/calibration/calibrator.hpp"
 #include "bbw/faults/detectors/detector.hpp"
@@ -39,6 +40,7 @@ class ResidualDetector {
   void forget_position() {
     friction_known_ = false;
     have_x_ = false;
+    clear_revisit();
   }
   // Call track_position() first with the same sample.
   void update(const CornerReading& r, const calibration::Estimate& e, const MonitorParams& p, DiagnosisArbiter& a,
@@ -70,6 +72,7 @@ class ResidualDetector {
   void restore_position() {
     if (have_saved_) position_state() = saved_;
     else forget_position();
+    clear_revisit();  // the samples since the jump were learnt at the wrong position
   }
   // Whether the end-of-line friction model's state is known (the position has swept twice its
   // largest threshold since the start or the last gap), and its friction (kN).
@@ -100,6 +103,10 @@ class ResidualDetector {
   double hold_change_kN() const { return hold_change_kN_; }
   // The allowance that change was held against (kN; NaN outside a hold).
   double hold_threshold_kN() const { return hold_threshold_kN_; }
+  // The revisit rule's change against the bin's level and its allowance (kN; NaN where the bin
+  // has no level yet or the rule is off).
+  double revisit_change_kN() const { return revisit_change_kN_; }
+  double revisit_threshold_kN() const { return revisit_threshold_kN_; }
 
  private:
   bool suspect_ = false;
@@ -148,6 +155,7 @@ class ResidualDetector {
   // identified them), driven by the measured position.
   std::optional<plant::KeyFriction> eol_friction_;
   double sweep_rev_ = 0.0;   // twice its largest threshold
+  double eol_friction_half_width_kN_ = 0.0;  // the model's (its elements' K x threshold)
   bool friction_known_ = false;
   bool have_x_ = false;
   double x_min_rev_ = 0.0, x_max_rev_ = 0.0;  // since the start or the last gap
@@ -175,6 +183,29 @@ class ResidualDetector {
   double hold_last_kN_ = std::numeric_limits<double>::quiet_NaN();
   double hold_last_x_rev_ = 0.0;
   double hold_last_curve_kN_ = 0.0;
+  // The revisit rule (MonitorParams::revisit): per position bin and class (moving up, down or
+  // slow; the keys all slipping one way or between), the healthy residual's level and the speed
+  // it was learnt at. Sized at construction.
+  static constexpr std::size_t kRevisitClasses = 6;
+  struct RevisitBin {
+    int n = 0;
+    double level_kN = 0.0;
+    double speed_rev_per_s = 0.0;
+  };
+  std::vector<RevisitBin> revisit_bins_;
+  int revisit_per_class_ = 0;
+  double revisit_min_rev_ = 0.0;
+  double revisit_kN_ = std::numeric_limits<double>::quiet_NaN();  // its residual (end-of-line curve and friction)
+  double revisit_time_s_ = 0.0;
+  double revisit_change_kN_ = std::numeric_limits<double>::quiet_NaN();
+  double revisit_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
+  void clear_revisit() {
+    for (RevisitBin& b : revisit_bins_) b = RevisitBin{};
+  }
+  // Judges the residual against its bin's level (sets revisit_change_kN_ and revisit_threshold_kN_);
+  // returns the bin (-1: none) for learn_revisit().
+  int judge_revisit(const CornerReading& r, double eol_keys_kN, bool& over, const MonitorParams& p);
+  void learn_revisit(int bin, double speed_rev_per_s, double dt_s, const MonitorParams& p);
 };
 
 }  // namespace bbw::faults
