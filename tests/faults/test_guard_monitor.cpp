@@ -1498,6 +1498,9 @@ TEST(FaultMonitor, AHoldCarriesADriftsChangeAcrossTheFirstFit) {
     MonitorParams p = eol_params(1.5, false);
     p.hold_rebase = rebase;
     p.revisit = false;  // the hold rule alone (the revisit rule, twenty-first session, names it at 5.15 s)
+    // The whole friction share, so that the drift outlives the first fit (with the allowance as
+    // the friction moved, twenty-first session, it is named before the fit, at 4.96 s).
+    p.hold_friction_as_moved = false;
     p.eol_relative = kEolRelativeUntilSession16;
     // The first fit comes at 5 s, in the hold; before it, the load cell as it is.
     return drift_in_a_hold(p, drift_kN_per_s, [](double t, double lc, double friction_kN, double curve_kN) {
@@ -1548,6 +1551,34 @@ TEST(FaultMonitor, CalibratedAHoldKeepsItsLevelWhileTheLearntStatisticsFollowADr
   EXPECT_EQ(learnt.finding, Finding::LoadCellOffset) << to_string(learnt.finding);
   EXPECT_LT(learnt.detected_s, window_end_s);
   EXPECT_FALSE(run(false, 0.0, running).present);
+}
+
+// The hold rule's friction allowance (hold.friction_as_moved): in a hold after an apply the keys
+// stay slipping the way they were, in the end-of-line model and on the caliper, so the model's
+// share of the friction's width is not needed; only the share of what the model's friction moved
+// since the hold settled. A -0.3 kN/s drift from 4 s in a held apply (the revisit rule off, to
+// judge the hold rule alone): named once the change passes 0.5 kN instead of 0.5 kN + a quarter
+// of the 1.5 kN half-width.
+TEST(FaultMonitor, AHoldWhoseKeysKeptSlippingOneWayNeedsNoFrictionAllowance) {
+  auto run = [](bool as_moved, double drift_kN_per_s) {
+    MonitorParams p = eol_params(1.5, false);
+    p.hold_friction_as_moved = as_moved;
+    p.revisit = false;
+    return drift_in_a_hold(p, drift_kN_per_s, [](double t, double lc, double friction_kN, double curve_kN) {
+      return fitted(t > 0.5, lc, friction_kN, curve_kN);
+    });
+  };
+  const auto healthy = run(true, 0.0);
+  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
+  const auto with = run(true, -0.3);
+  const auto without = run(false, -0.3);
+  EXPECT_EQ(with.finding, Finding::LoadCellOffset) << to_string(with.finding);
+  EXPECT_EQ(without.finding, Finding::LoadCellOffset) << to_string(without.finding);
+  // 0.5 kN and 0.875 kN (+ the curve's 1 %) of a 0.3 kN/s drift: 1.25 s sooner.
+  EXPECT_LT(with.detected_s, 4.0 + 0.6 / 0.3);
+  EXPECT_GT(without.detected_s, 4.0 + 0.85 / 0.3);
+  std::printf("a -0.3 kN/s drift from 4 s in a hold: named at %.3f s (with the whole share: %.3f s)\n", with.detected_s,
+              without.detected_s);
 }
 
 // The revisit rule: a calibrated corner modulated like an ABS (6 Hz, +-0.15 rev about 4.5 rev)

@@ -65,7 +65,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(force_limit_kN); SAME(release_min_speed_rev_per_s); SAME(deadline_s);
   SAME(residual_stats_clip); SAME(eol_friction_model_share); SAME(calibrated_two_friction_models); SAME(calibrated_capped_by_eol);
   SAME(hold_kN); SAME(hold_speed_rev_per_s); SAME(hold_span_rev); SAME(hold_span_known_rev); SAME(hold_settle_samples);
-  SAME(hold_calibrated); SAME(hold_rebase);
+  SAME(hold_calibrated); SAME(hold_rebase); SAME(hold_friction_as_moved);
   SAME(revisit); SAME(revisit_kN); SAME(revisit_bin_rev); SAME(revisit_settle_samples); SAME(revisit_forget_s);
   SAME(stuck_frozen_samples); SAME(stuck_frozen_run_factor); SAME(stuck_resolver_clear_samples);
   SAME(step_still_samples); SAME(step_still_span_rev); SAME(step_min_position_changes); SAME(step_kN); SAME(step_keep_fraction);

@@ -53,6 +53,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.hold_settle_samples = static_cast<int>(h.integer("settle_samples", 1, 100000));
     p.hold_calibrated = h.boolean("calibrated");
     p.hold_rebase = h.boolean("rebase");
+    p.hold_friction_as_moved = h.boolean("friction_as_moved");
     h.finish();
   }
   {

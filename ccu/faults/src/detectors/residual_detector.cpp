@@ -335,6 +335,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     hold_r0_kN_ += residual_kN_ - hold_last_kN_;
     hold_x0_rev_ += x_hold - hold_last_x_rev_;
     hold_f0_kN_ += hold_curve_kN - hold_last_curve_kN_;
+    if (hold_known_ != friction_known_) hold_friction_ref_ = false;  // its state just became known
     hold_eol_mode_ = eol_here;
     hold_known_ = friction_known_;
     redefined = false;
@@ -362,11 +363,21 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       hold_r0_kN_ = hold_sum_kN_ / hold_slow_;
       hold_x0_rev_ = x_hold;
       hold_f0_kN_ = hold_curve_kN;
+      hold_friction0_kN_ = eol_friction_kN_;
+      hold_friction_ref_ = friction_known_;
     }
   } else if (hold_ref_) {
     hold_change_kN_ = residual_kN_ - hold_r0_kN_;
-    const double hold_thr = eol_allowance_kN(p, p.hold_kN, (friction_known_ ? p.eol_friction_model_share : 1.0) * p.eol_friction_half_width_kN,
-                                             hold_curve_kN - hold_f0_kN_, r.speed_rev_per_s);
+    // The friction's uncertainty: its whole width while the model's state is unknown, else the
+    // model's share of it; with hold.friction_as_moved, the share of what the model's friction
+    // moved since the hold settled (at most the width): keys that went on slipping the same way
+    // (a drive creeping on into the load) kept their friction, in the model and on the caliper.
+    double friction_kN = (friction_known_ ? p.eol_friction_model_share : 1.0) * p.eol_friction_half_width_kN;
+    if (friction_known_ && hold_friction_ref_ && p.hold_friction_as_moved) {
+      const double moved_kN = std::abs(eol_friction_kN_ - hold_friction0_kN_);
+      friction_kN = p.eol_friction_model_share * std::min(p.eol_friction_half_width_kN, moved_kN);
+    }
+    const double hold_thr = eol_allowance_kN(p, p.hold_kN, friction_kN, hold_curve_kN - hold_f0_kN_, r.speed_rev_per_s);
     hold_threshold_kN_ = hold_thr;
     hold_over = std::abs(hold_change_kN_) > hold_thr;
   }

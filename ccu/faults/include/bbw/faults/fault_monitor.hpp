@@ -115,6 +115,9 @@ struct MonitorParams {
   // A settled hold carries its change across a change of the residual's definition or a new
   // fit (its reference moves by the residual's jump between two samples) instead of restarting.
   bool hold_rebase = true;
+  // The hold's friction allowance: the friction model's share of what its friction moved since
+  // the hold settled (at most the width), instead of the share of the whole width.
+  bool hold_friction_as_moved = true;
   // Revisit rule: where the drive has been before (a position bin of revisit_bin_rev, moving up,
   // moving down or slower than hold_speed_rev_per_s), the residual keeps the level it had there:
   // the curve and the friction are the same there, a load-cell drift is not. A bin's level is the

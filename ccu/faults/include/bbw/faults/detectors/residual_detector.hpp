@@ -176,6 +176,8 @@ class ResidualDetector {
   double hold_r0_kN_ = 0.0;
   double hold_x0_rev_ = 0.0;
   double hold_f0_kN_ = 0.0;
+  double hold_friction0_kN_ = 0.0;  // the end-of-line friction model's when the hold settled
+  bool hold_friction_ref_ = false;   // ... and whether its state was known then (and since)
   double hold_change_kN_ = std::numeric_limits<double>::quiet_NaN();
   double hold_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
   bool hold_refit_ = false;  // a fit was accepted since the last sample
