@@ -79,8 +79,9 @@ int ResidualDetector::judge_revisit(const CornerReading& r, double eol_keys_kN, 
   // The motion (up, down, slower than a hold either way) and the keys' state: slipping all one
   // way (the model's friction within 2 % of its half-width) or between (after a reversal): there
   // the model's error depends on where the reversal was, not only on the position.
+  constexpr double kSlippingFraction = 0.98;
   const int direction = r.speed_rev_per_s > p.hold_speed_rev_per_s ? 0 : r.speed_rev_per_s < -p.hold_speed_rev_per_s ? 1 : 2;
-  const bool between = std::abs(eol_friction_kN_) < 0.98 * eol_friction_half_width_kN_;
+  const bool between = std::abs(eol_friction_kN_) < kSlippingFraction * eol_friction_half_width_kN_;
   const int motion = 2 * direction + (between ? 1 : 0);
   const int bin = motion * revisit_per_class_ + i;
   const RevisitBin& b = revisit_bins_[static_cast<std::size_t>(bin)];

@@ -118,13 +118,14 @@ struct MonitorParams {
   // The hold's friction allowance: the friction model's share of what its friction moved since
   // the hold settled (at most the width), instead of the share of the whole width.
   bool hold_friction_as_moved = true;
-  // Revisit rule: where the drive has been before (a position bin of revisit_bin_rev, moving up,
-  // moving down or slower than hold_speed_rev_per_s), the residual keeps the level it had there:
-  // the curve and the friction are the same there, a load-cell drift is not. A bin's level is the
-  // mean of its first revisit_settle_samples healthy residuals, then low-passed over
-  // revisit_forget_s of time spent in it. A change beyond revisit_kN + eol_speed x the speed's
-  // change from the bin's (+ the friction model's share of the width when slow) is a
-  // disagreement. The bins start again whenever the residual's definition changes.
+  // Revisit rule: where the drive has been before, the load cell against the end-of-line curve
+  // and friction model keeps the level it had there (the curve and the friction are the same
+  // there, a load-cell drift is not). Per position bin of revisit_bin_rev and class (moving up,
+  // down or slower than hold_speed_rev_per_s; the model's keys all slipping one way or between),
+  // a bin's level is the mean of its first revisit_settle_samples healthy residuals, then
+  // low-passed over revisit_forget_s of time spent in it. A change beyond revisit_kN +
+  // eol_speed x the speed's change from the bin's (+ the friction model's share of the width
+  // when between) is a disagreement. The bins start again when the position is lost or restored.
   bool revisit = true;
   double revisit_kN = 0.6;
   double revisit_bin_rev = 0.05;

@@ -3,7 +3,9 @@
 // scaled by the fit's residual RMS; elsewhere (before the first fit, beyond the fitted range)
 // r = load cell - end-of-line curve(position, temperature) against the end-of-line band
 // (MonitorParams). A residual beyond its threshold, or (calibrated) a change against its own
-// recent level beyond the change threshold, that persists is a disagreement; isolation names the channel that explains it (a frozen position: ResolverStuck;
+// recent level beyond the change threshold, or (with an end-of-line curve) a change against its
+// level where the drive has been before (the revisit rule) or since a hold settled (the hold rule),
+// that persists is a disagreement; isolation names the channel that explains it (a frozen position: ResolverStuck;
 // a frozen load cell: LoadCellStuck; a recent position jump: ResolverOffset; else
 // LoadCellOffset). Feeds the noise detector with every residual.
 #pragma once
