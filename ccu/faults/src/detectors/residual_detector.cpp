@@ -28,7 +28,6 @@ ResidualDetector::ResidualDetector(const MonitorParams& p)
     stats_clip_moment_ = (1.0 - tail) - 2.0 * c * phi + c * c * tail;
   }
   if (p.revisit) {
-    revisit_min_rev_ = p.curve_min_rev;
     revisit_per_class_ = std::max(1, static_cast<int>(std::ceil((p.curve_max_rev - p.curve_min_rev) / p.revisit_bin_rev)));
     revisit_bins_.resize(kRevisitClasses * static_cast<std::size_t>(revisit_per_class_));
   }
@@ -74,7 +73,7 @@ int ResidualDetector::judge_revisit(const CornerReading& r, double eol_keys_kN, 
   // holds the key friction's whole width wherever it happens to be: no level to come back to.
   if (revisit_bins_.empty() || !eol_ || !friction_known_ || !std::isfinite(r.force_kN)) return -1;
   revisit_kN_ = r.force_kN - eol_keys_kN - eol_friction_kN_;
-  const int i = static_cast<int>(std::floor((r.position_rev - revisit_min_rev_) / p.revisit_bin_rev));
+  const int i = static_cast<int>(std::floor((r.position_rev - p.curve_min_rev) / p.revisit_bin_rev));
   if (i < 0 || i >= revisit_per_class_) return -1;
   // The motion (up, down, slower than a hold either way) and the keys' state: slipping all one
   // way (the model's friction within 2 % of its half-width) or between (after a reversal): there

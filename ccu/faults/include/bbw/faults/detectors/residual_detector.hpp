@@ -40,9 +40,11 @@ class ResidualDetector {
   // The position is not trusted (the resolver diagnosed): the friction model's state is lost
   // with it and is found again by sweeping once the position is back.
   void forget_position() {
+    // The bins learn only where the position is tracked: once forgotten, they are already clear
+    // (called every sample while the resolver is diagnosed).
+    if (have_x_) clear_revisit();
     friction_known_ = false;
     have_x_ = false;
-    clear_revisit();
   }
   // Call track_position() first with the same sample.
   void update(const CornerReading& r, const calibration::Estimate& e, const MonitorParams& p, DiagnosisArbiter& a,
@@ -72,9 +74,9 @@ class ResidualDetector {
     have_saved_ = true;
   }
   void restore_position() {
+    clear_revisit();  // the samples since the jump were learnt at the wrong position
     if (have_saved_) position_state() = saved_;
     else forget_position();
-    clear_revisit();  // the samples since the jump were learnt at the wrong position
   }
   // Whether the end-of-line friction model's state is known (the position has swept twice its
   // largest threshold since the start or the last gap), and its friction (kN).
@@ -197,8 +199,7 @@ class ResidualDetector {
     double speed_rev_per_s = 0.0;
   };
   std::vector<RevisitBin> revisit_bins_;
-  int revisit_per_class_ = 0;
-  double revisit_min_rev_ = 0.0;
+  int revisit_per_class_ = 0;  // bins per class from curve_min_rev
   double revisit_kN_ = std::numeric_limits<double>::quiet_NaN();  // its residual (end-of-line curve and friction)
   double revisit_time_s_ = 0.0;
   double revisit_change_kN_ = std::numeric_limits<double>::quiet_NaN();
