@@ -338,13 +338,17 @@ TEST(ClosedLoop, AHalfLostMotorInAHoldIsATorqueLossNotALostActuator) {
 
   // Once named, the drive is judged as the weaker drive it is: a 67 % loss stays a torque loss
   // through the release (the lost rules look for a further loss); judged against the healthy
-  // drive it is named lost at the release, when the loop drives the weak motor back.
+  // drive, and with a pull judged without its fraction (torque.unexplained_pull_fraction), it is
+  // named lost at the release, when the loop drives the weak motor back. The pull's fraction alone
+  // keeps it a torque loss there too (a pull 3 times its need is not in vain).
   auto weaker = fs;
   weaker.faults.faults[0].torque_loss_percent = 67.0;
   const auto kept = run_closed_loop(weaker, default_options());
   EXPECT_EQ(actuator(kept, 0).finding, Finding::ActuatorTorqueLoss);
   auto healthy_model = default_options();
   healthy_model.monitor.torque_loss_rescales_drive = false;
+  EXPECT_EQ(actuator(run_closed_loop(weaker, healthy_model), 0).finding, Finding::ActuatorTorqueLoss);
+  healthy_model.monitor.unexplained_pull_fraction = false;
   const auto upgraded = run_closed_loop(weaker, healthy_model);
   EXPECT_EQ(actuator(upgraded, 0).finding, Finding::ActuatorLost);
   EXPECT_GT(actuator(upgraded, 0).finding_s, 6.0);  // at the release (6.0-6.5 s)

@@ -52,12 +52,12 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(eol_band_kN); SAME(eol_relative); SAME(eol_speed_kN_per_rev_per_s); SAME(eol_friction_amplitude_factor);
   SAME(jump_threshold_rev); SAME(jump_confirm_s); SAME(jump_window_s); SAME(jump_max_gap_s); SAME(jump_compensate);
   SAME(stuck_samples); SAME(stuck_min_travel_rev); SAME(stuck_min_force_change_kN); SAME(frozen_attribution_samples);
-  SAME(noise_window_samples); SAME(noise_step_kN); SAME(noise_second_difference_learn_s); SAME(noise_min_fraction); SAME(dropout_samples); SAME(dropout_clear_samples);
+  SAME(noise_window_samples); SAME(noise_step_kN); SAME(noise_second_difference_learn_s); SAME(noise_released); SAME(noise_min_fraction); SAME(dropout_samples); SAME(dropout_clear_samples);
   SAME(torque_per_A_Nm); SAME(Nm_per_kN); SAME(inertia_kg_m2);
   SAME(torque_filter_s); SAME(torque_check_min_load_kN); SAME(torque_check_min_torque_Nm);
   SAME(torque_fraction_threshold); SAME(torque_check_max_speed_rev_per_s); SAME(torque_check_moving_min_speed_rev_per_s); SAME(torque_check_moving_min_load_kN);
   SAME(torque_persist_s);
-  SAME(torque_lost_threshold); SAME(torque_lost_persist_s); SAME(torque_loss_rescales_drive); SAME(torque_lost_unmeasured_load_high); SAME(torque_lost_braking); SAME(torque_lost_braking_threshold); SAME(torque_loss_braking_threshold); SAME(torque_check_moving_low_load_kN); SAME(torque_after_resolver_offset); SAME(torque_stop_margin_rev);
+  SAME(torque_lost_threshold); SAME(torque_lost_persist_s); SAME(torque_loss_rescales_drive); SAME(torque_lost_unmeasured_load_high); SAME(torque_lost_braking); SAME(torque_lost_braking_threshold); SAME(torque_loss_braking_threshold); SAME(torque_check_moving_low_load_kN); SAME(torque_after_resolver_offset); SAME(torque_stop_margin_rev); SAME(unexplained_pull_fraction); SAME(seized_ramp_off_command_Nm);
   SAME(test_pulse_max_speed_rev_per_s); SAME(test_pulse_answer_ratio); SAME(test_pulse_unanswered); SAME(test_pulse_within_s);
   SAME(test_pulse_lost_mean_ratio); SAME(test_pulse_crossing_extremes); SAME(test_pulse_rescaled_after_loss); SAME(test_pulse_weak_count); SAME(test_pulse_weak_fraction);
   SAME(test_pulse_healthy_ratio); SAME(test_pulse_learn_count);

@@ -133,6 +133,8 @@ void MonitorParams::validate() const {
   positive("seized_window_s", seized_window_s);
   positive("seized_ramp_Nm", seized_ramp_Nm);
   positive("seized_force_error_kN", seized_force_error_kN);
+  require(seized_ramp_off_command_Nm == 0.0 || seized_ramp_off_command_Nm >= seized_ramp_Nm, "seized_ramp_off_command_Nm",
+          seized_ramp_off_command_Nm, "must be 0 (off) or >= seized_ramp_Nm");
   require(std::isfinite(test_pulse_current_A) && test_pulse_current_A >= 0.0, "test_pulse_current_A",
           test_pulse_current_A, "must be >= 0");
   require(test_pulse_s >= 0.0005 && test_pulse_s <= 0.007, "test_pulse_s", test_pulse_s, "must be in [0.0005, 0.007]");

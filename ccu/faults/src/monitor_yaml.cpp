@@ -127,6 +127,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.noise_learned_factor = n.number("learned_factor", Range{0.0, 100.0, true, true});
   p.noise_learn_time_constant_s = n.number("learn_time_constant_s", pos);
   p.noise_second_difference_learn_s = n.number("second_difference_learn_s", pos);
+  p.noise_released = n.boolean("released");
   n.finish();
 
   auto d = r.map("dropout");
@@ -166,12 +167,14 @@ MonitorParams read_monitor_params(Reader& r) {
   p.torque_stop_margin_rev = t.number("stop_margin_rev", config::Range::non_negative());
   p.unexplained_margin_Nm = t.number("unexplained_margin_Nm", pos);
   p.unexplained_relative = t.number("unexplained_relative", Range::closed(0.0, 10.0));
+  p.unexplained_pull_fraction = t.boolean("unexplained_pull_fraction");
   p.unexplained_max_speed_rev_per_s = t.number("unexplained_max_speed_rev_per_s", pos);
   p.unexplained_persist_s = t.number("unexplained_persist_s", pos);
   p.seized_static_rev = t.number("seized_static_rev", pos);
   p.seized_window_s = t.number("seized_window_s", pos);
   p.seized_ramp_Nm = t.number("seized_ramp_Nm", pos);
   p.seized_force_error_kN = t.number("seized_force_error_kN", pos);
+  p.seized_ramp_off_command_Nm = t.number("seized_ramp_off_command_Nm", config::Range::non_negative());
   t.finish();
 
   auto k = r.map("tracking");

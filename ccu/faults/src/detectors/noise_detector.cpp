@@ -44,7 +44,7 @@ void NoiseDetector::LearntLevel::learn(double value_kN, double t, bool quiet, do
 }
 
 void NoiseDetector::update_load_cell_difference(double difference_kN, double t, const MonitorParams& p,
-                                                DiagnosisArbiter& a) {
+                                                DiagnosisArbiter& a, bool before_learnt) {
   if (!have_prev_difference_) {
     have_prev_difference_ = true;
     prev_difference_kN_ = difference_kN;
@@ -62,8 +62,9 @@ void NoiseDetector::update_load_cell_difference(double difference_kN, double t, 
   const double tc_s = p.noise_learn_time_constant_s;
   double big_kN = p.noise_second_difference_kN;
   if (step_level_.learnt(tc_s)) big_kN = std::max(big_kN, p.noise_learned_factor * kSqrt3 * step_level_.mean_kN);
-  if (second_level_.learnt(p.noise_second_difference_learn_s)) big_kN = std::max(big_kN, p.noise_learned_factor * second_level_.mean_kN);
-  count(std::abs(second_kN) > big_kN, t, p, a);
+  const bool second_learnt = second_level_.learnt(p.noise_second_difference_learn_s);
+  if (second_learnt) big_kN = std::max(big_kN, p.noise_learned_factor * second_level_.mean_kN);
+  if (before_learnt || second_learnt || step_level_.learnt(tc_s)) count(std::abs(second_kN) > big_kN, t, p, a);
   second_level_.learn(second_kN, t, fraction_ < p.noise_min_fraction, tc_s);
 }
 

@@ -152,7 +152,16 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // small motions by up to its full width within milliseconds: that is not sensor noise.
   const double curve_kN = eol_keys_kN + (eol_ && friction_known_ ? eol_friction_kN_ : 0.0);
   const double noise_kN = std::isfinite(r.force_kN) ? r.force_kN - curve_kN : residual_kN_;
-  if (r.position_rev >= trusted_min_rev_ || !eol_) noise.update(noise_kN, curve_kN, t, p, a);
+  // Below it (released), the load cell's own second differences (MonitorParams::noise_released),
+  // once their level is learnt.
+  if (r.position_rev >= trusted_min_rev_ || !eol_) {
+    noise.update(noise_kN, curve_kN, t, p, a);
+  } else if (p.noise_released && std::isfinite(r.force_kN) && std::isfinite(prev_lc_kN_) && t > prev_lc_time_s_ &&
+             t - prev_lc_time_s_ <= p.jump_max_gap_s) {
+    noise.update_load_cell_difference(r.force_kN - prev_lc_kN_, t, p, a, false);
+  }
+  prev_lc_kN_ = r.force_kN;
+  prev_lc_time_s_ = t;
   // With an end-of-line curve, a calibrated corner's residual is its estimate (load cell minus
   // the calibrator's friction) against that curve, everywhere above the trusted minimum: the
   // fitted cubic is an approximation fitted to wherever the cycles went, the end-of-line curve

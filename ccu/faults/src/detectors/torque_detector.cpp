@@ -166,8 +166,11 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // The loop winds up against a rotor that does not turn. (Not down: a healthy hold's current
   // may fall to about 0 A while the drive's and the keys' friction hold the load; tried on the
   // tuning seed, 3 fault-free false alarms in hard stops.)
-  const bool winding_up = stopped && on_command && t - static_since_s_ >= p.seized_window_s &&
-                          make_Nm_ - static_min_make_Nm_ >= p.seized_ramp_Nm;
+  // Off the command, by more than any friction can hold a healthy drive back (breaking away).
+  const double ramp_Nm = make_Nm_ - static_min_make_Nm_;
+  const bool winding_up = stopped && t - static_since_s_ >= p.seized_window_s &&
+                          (on_command ? ramp_Nm >= p.seized_ramp_Nm
+                                      : p.seized_ramp_off_command_Nm > 0.0 && ramp_Nm >= p.seized_ramp_off_command_Nm);
   // Pushing: beyond the band and less than the lost threshold of it needed (a partial torque
   // loss the loop absorbs is not a lost actuator), or winding up against a seized drive.
   // (After a named torque loss the motor makes motor_scale_ of it, either way: each rule takes the
@@ -182,7 +185,14 @@ void TorqueDetector::update(const SampleContext& c, double load_kN, bool load_ce
   // current limit and does not move (tuning seed 1401 run 301, a loop releasing after a drifting
   // load cell).
   const bool at_stop = r.position_rev <= p.drive.retracted_stop_rev + p.torque_stop_margin_rev;
-  const bool pulling = !at_stop && need_lo_Nm_ - pull_Nm > band + load_Nm;
+  // And, as pushing, with less than the lost threshold of the pull needed, the drive's friction
+  // against it and, on a caliper with play, the load carried or not (in the gap the need is the
+  // acceleration's alone): a partial loss the loop absorbs pulls harder, not in vain
+  // (MonitorParams::unexplained_pull_fraction).
+  const double gap_Nm = p.eol_backlash_rev > 0.0 ? load_Nm : 0.0;
+  const bool pull_in_vain = !p.unexplained_pull_fraction ||
+                            need_lo_Nm_ - gap_Nm - p.drive.coulomb_friction_Nm > p.torque_lost_threshold * pull_Nm;
+  const bool pulling = !at_stop && need_lo_Nm_ - pull_Nm > band + load_Nm && pull_in_vain;
   if (slow && (pushing || pulling)) {
     if (!unexplained_suspect_) {
       unexplained_suspect_ = true;

@@ -263,6 +263,13 @@ struct MonitorParams {
   // noise_second_difference_kN within a window, 32 ms, before it could be learnt; a healthy 0.08 kN
   // load cell crosses that threshold in 7 % of samples and was named noisy within 0.25 s).
   double noise_second_difference_learn_s = 0.1;
+  // Below the trusted range (released: the residual is not judged there, the keys snap), the load
+  // cell's own second differences as above (twenty-second session: tuning seed 1403 run 506, a
+  // 0.55 kN RMS burst from 0.56 s while the pads were still off the disc, named only at 1.28 s
+  // once the clamp force reached the trusted range). Counted only once their own level is learnt
+  // (noise_second_difference_learn_s) or the residual's: the fixed threshold raised 9 fault-free
+  // findings in the first 0.1 s on the stress population's noisier load cells (stress seed 1406).
+  bool noise_released = true;
 
   // Dropout: consecutive samples without a load-cell value.
   int dropout_samples = 5;
@@ -345,6 +352,12 @@ struct MonitorParams {
   // + unexplained_relative |need|. Pulling: need - make > the same + |need| (a gear in its
   // backlash gap carries none of the load the load cell reads). For unexplained_persist_s:
   // ActuatorLost.
+  // Pulling, also: what the pull needs (the load carried or not, and the drive's friction against
+  // it) is less than torque_lost_threshold of the pull, as pushing (twenty-second session). A
+  // partial torque loss the loop absorbs pulls harder than a healthy drive, not without answer
+  // (tuning seed 1401 run 341: a 72 % loss braking a release at 2 kN pulled 3.5 times its need
+  // and was named lost).
+  bool unexplained_pull_fraction = true;
   plant::TransmissionParams drive;            // the drive's friction (the plant's transmission: plant::drive_friction_Nm)
   double unexplained_margin_Nm = 0.1;
   double unexplained_relative = 0.3;
@@ -360,6 +373,13 @@ struct MonitorParams {
   double seized_window_s = 0.1;
   double seized_ramp_Nm = 0.3;
   double seized_force_error_kN = 0.5;
+  // Off its command the same, once the made torque has risen by this much since the drive stopped
+  // (twenty-second session): a healthy drive breaking away towards its command turns once the rise
+  // passes the friction that can hold it (2 x (the drive's 0.05 Nm + the keys' half-width x
+  // Nm_per_kN), 0.26 Nm at a 2 kN half-width); a seized one does not (tuning seed 1401 run 124: a
+  // drive seized in a 24 kN hold, its force estimate 3 kN below the command after a stuck load
+  // cell, wound its current from 3.5 to 40 A and was named a torque loss). 0: off.
+  double seized_ramp_off_command_Nm = 1.0;
   // The corners' actuator test in holds (issue 14; corner_unit::ControllerParams::hold_test_*,
   // set from the scenario): the loops hold their current I, the command is I - a for test_pulse_s,
   // then I + a, a = |I| + test_pulse_current_A. Recognised in the measured current (it fell by at

@@ -23,7 +23,10 @@ class NoiseDetector {
   // Without a residual (the resolver is diagnosed): the load cell's first difference F[k] - F[k-1];
   // its change, the second difference, counts as big beyond noise_second_difference_kN, or
   // beyond the corner's own learnt level (from its residual before, and from these differences).
-  void update_load_cell_difference(double difference_kN, double t, const MonitorParams& p, DiagnosisArbiter& a);
+  // Not `before_learnt`: counted only once that level is learnt (noise_second_difference_learn_s)
+  // or the residual's is.
+  void update_load_cell_difference(double difference_kN, double t, const MonitorParams& p, DiagnosisArbiter& a,
+                                   bool before_learnt = true);
   void on_rejoin() { have_prev_residual_ = have_prev_difference_ = false; }
   double fraction() const { return fraction_; }
 

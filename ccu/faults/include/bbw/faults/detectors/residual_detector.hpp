@@ -202,6 +202,9 @@ class ResidualDetector {
   int revisit_per_class_ = 0;  // bins per class from curve_min_rev
   double revisit_kN_ = std::numeric_limits<double>::quiet_NaN();  // its residual (end-of-line curve and friction)
   double revisit_time_s_ = 0.0;
+  // The load cell's previous reading and its time (the released noise path, below the trusted range).
+  double prev_lc_kN_ = std::numeric_limits<double>::quiet_NaN();
+  double prev_lc_time_s_ = 0.0;
   double revisit_change_kN_ = std::numeric_limits<double>::quiet_NaN();
   double revisit_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
   void clear_revisit() {
