@@ -1679,6 +1679,7 @@ TEST(FaultMonitor, TheRevisitRuleFindsADriftWhereTheDriveHasBeenBefore) {
   auto run = [](bool revisit, double drift_kN_per_s) {
     MonitorParams p = eol_params(1.5, false);
     p.revisit = revisit;
+    p.modulation = false;  // the revisit rule alone (the modulation rule's test is below)
     EolCaliper caliper{p};
     auto& [eol, keys, T] = caliper;
     FaultMonitor m(p, Target::FR);
@@ -1714,6 +1715,52 @@ TEST(FaultMonitor, TheRevisitRuleFindsADriftWhereTheDriveHasBeenBefore) {
   EXPECT_EQ(up.finding, Finding::LoadCellOffset) << to_string(up.finding);
   EXPECT_LT(up.detected_s, window_end_s);
   std::printf("revisit rule: drift -1 kN/s from 4 s named at %.3f s (without it: %s %.3f s), +1 kN/s at %.3f s\n",
+              with.detected_s, without.present ? "named at" : "not named;", without.detected_s, up.detected_s);
+}
+
+// The modulation rule: an ABS-like corner as above (6 Hz, +-0.15 rev about 4.5 rev, up to 5.7
+// rev/s), its clamp curve the end-of-line one, its load cell reading 0.1 kN per rev/s of speed off
+// the clamp force (a sensor delay, viscous keys), the revisit rule off. The level rule's allowance
+// grows by 0.3 kN per rev/s beyond 3 rev/s, so a -1 kN/s drift from 4 s is over it only around the
+// reversals, for less than its persistence, until 0.13 s after its window. Fitted as c + a v + b sign(v) over the last 0.2 s, the residual
+// at standstill is judged against the threshold at standstill: named 0.2 s inside it, either way.
+TEST(FaultMonitor, TheModulationRuleJudgesTheResidualAtStandstill) {
+  auto run = [](bool modulation, double drift_kN_per_s) {
+    MonitorParams p = eol_params(1.5, false);
+    p.revisit = false;
+    p.modulation = modulation;
+    EolCaliper caliper{p};
+    auto& [eol, keys, T] = caliper;
+    FaultMonitor m(p, Target::FR);
+    SampleGuard g{MonitorParams{}.guard};
+    for (int n = 1; n < 7000; ++n) {
+      const double t = 0.001 * n;
+      const double w = 2.0 * M_PI * 6.0;
+      const double speed = t >= 1.0 ? 0.15 * w * std::cos(w * (t - 1.0)) : 4.5;
+      const double x = t < 1.0 ? 4.5 * t : 4.5 + 0.15 * std::sin(w * (t - 1.0));
+      const double friction_kN = keys.step(x);
+      const double drift_kN = t > 4.0 ? drift_kN_per_s * (t - 4.0) : 0.0;
+      const double clamp_kN = eol.force_kN(x, T, 0.0);
+      const double lc = clamp_kN + friction_kN + 0.1 * speed + drift_kN + 0.03 * ((n % 5) - 2);
+      const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
+      const auto e = fitted(t > 0.5, lc, friction_kN, clamp_kN);
+      m.update(r, g.check(r), &e, e.force_kN, t);
+    }
+    return m.diagnosis(Part::LoadCell);
+  };
+  const double window_end_s = 4.0 + 1.0 / 1.0 + 0.5;
+  const auto healthy = run(true, 0.0);
+  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
+  const auto without = run(false, -1.0);
+  EXPECT_TRUE(!without.present || without.detected_s > window_end_s) << without.detected_s;
+  const auto with = run(true, -1.0);
+  EXPECT_EQ(with.finding, Finding::LoadCellOffset) << to_string(with.finding);
+  EXPECT_GT(with.detected_s, 4.0);
+  EXPECT_LT(with.detected_s, window_end_s);
+  const auto up = run(true, 1.0);
+  EXPECT_EQ(up.finding, Finding::LoadCellOffset) << to_string(up.finding);
+  EXPECT_LT(up.detected_s, window_end_s);
+  std::printf("modulation rule: drift -1 kN/s from 4 s named at %.3f s (without it: %s %.3f s), +1 kN/s at %.3f s\n",
               with.detected_s, without.present ? "named at" : "not named;", without.detected_s, up.detected_s);
 }
 

@@ -66,7 +66,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(residual_stats_clip); SAME(eol_friction_model_share); SAME(calibrated_two_friction_models); SAME(calibrated_capped_by_eol);
   SAME(hold_kN); SAME(hold_speed_rev_per_s); SAME(hold_span_rev); SAME(hold_span_known_rev); SAME(hold_settle_samples);
   SAME(hold_calibrated); SAME(hold_rebase); SAME(hold_friction_as_moved);
-  SAME(revisit); SAME(revisit_kN); SAME(revisit_bin_rev); SAME(revisit_settle_samples); SAME(revisit_forget_s);
+  SAME(revisit); SAME(revisit_kN); SAME(revisit_bin_rev); SAME(revisit_settle_samples); SAME(revisit_forget_s); SAME(modulation); SAME(modulation_time_constant_s); SAME(modulation_min_spread_rev_per_s);
   SAME(stuck_frozen_samples); SAME(stuck_frozen_run_factor); SAME(stuck_resolver_clear_samples);
   SAME(step_still_samples); SAME(step_still_span_rev); SAME(step_min_position_changes); SAME(step_kN); SAME(step_keep_fraction);
   SAME(unpowered_hold); SAME(unpowered_max_current_A); SAME(unpowered_settle_samples); SAME(unpowered_max_speed_rev_per_s); SAME(unpowered_min_load_margin_kN); SAME(unpowered_kN);

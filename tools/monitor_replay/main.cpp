@@ -90,7 +90,7 @@ int run(int argc, char** argv) {
                     c_lc = col("force_internal_kN"), c_true = col("force_true_kN"), c_T = col("temperature_C"),
                     c_i = col("motor_current_A"), c_cmd = col("command"), c_mode = col("force_mode");
   std::printf("# half_width_kN %.3f\n", mp.eol_friction_half_width_kN);
-  std::printf("t x v lc true lc-true fric est curve res thr chg chgthr cal fitrms fin_lc fin_act cmd sumphi i_A tfrac hold holdthr rev revthr\n");
+  std::printf("t x v lc true lc-true fric est curve res thr chg chgthr cal fitrms fin_lc fin_act cmd sumphi i_A tfrac hold holdthr rev revthr mod modthr\n");
   long n = 0;
   for (long line_no = 2; std::getline(in, line); ++line_no) {
     std::vector<double> c;
@@ -119,14 +119,14 @@ int run(int argc, char** argv) {
     for (std::size_t k = 0; k < fr.delta_rev.size(); ++k) sumphi += fr.delta_rev[k] * fr.stiffness_kN_per_rev[k];
     if (r.time_s < from || r.time_s > to || n % every != 0) continue;
     const double truth = c[c_true];
-    std::printf("%.3f %.4f %.2f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %d %.3f %s %s %.2f %.3f %.2f %.3f %.3f %.3f %.3f %.3f\n", r.time_s, r.position_rev,
+    std::printf("%.3f %.4f %.2f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %.3f %d %.3f %s %s %.2f %.3f %.2f %.3f %.3f %.3f %.3f %.3f %.3f %.3f\n", r.time_s, r.position_rev,
                 r.speed_rev_per_s, r.force_kN, truth, r.force_kN - truth, e.friction_kN, sup.view().force_estimate_kN, e.curve_force_kN,
                 m.last_residual_kN(), m.last_residual_threshold_kN(), m.last_residual_change_kN(),
                 m.last_residual_change_threshold_kN(), e.calibrated ? 1 : 0, sup.calibrator().stats().last_fit_rms_kN,
                 bbw::faults::to_string(m.diagnosis(bbw::faults::Part::LoadCell).finding),
                 bbw::faults::to_string(m.diagnosis(bbw::faults::Part::Actuator).finding), r.force_command_kN, sumphi,
                 r.motor_current_A, m.torque_fraction(), m.last_hold_change_kN(), m.last_hold_threshold_kN(),
-                m.last_revisit_change_kN(), m.last_revisit_threshold_kN());
+                m.last_revisit_change_kN(), m.last_revisit_threshold_kN(), m.last_modulation_kN(), m.last_modulation_threshold_kN());
   }
   return 0;
 }

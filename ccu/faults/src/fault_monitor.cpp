@@ -44,6 +44,8 @@ void MonitorParams::validate() const {
   positive("revisit_bin_rev", revisit_bin_rev);
   require(revisit_settle_samples >= 1, "revisit_settle_samples", revisit_settle_samples, "must be >= 1");
   positive("revisit_forget_s", revisit_forget_s);
+  positive("modulation_time_constant_s", modulation_time_constant_s);
+  positive("modulation_min_spread_rev_per_s", modulation_min_spread_rev_per_s);
   require(std::isfinite(eol_backlash_rev) && eol_backlash_rev >= 0.0, "eol_backlash_rev", eol_backlash_rev, "must be >= 0");
   require(std::isfinite(eol_friction_model_share) && eol_friction_model_share >= 0.0 && eol_friction_model_share <= 1.0,
           "eol_friction_model_share", eol_friction_model_share, "must be in [0, 1]");

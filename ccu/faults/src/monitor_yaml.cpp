@@ -65,6 +65,13 @@ MonitorParams read_monitor_params(Reader& r) {
     p.revisit_forget_s = v.number("forget_s", pos);
     v.finish();
   }
+  {
+    auto m = res.map("modulation");
+    p.modulation = m.boolean("enabled");
+    p.modulation_time_constant_s = m.number("time_constant_s", pos);
+    p.modulation_min_spread_rev_per_s = m.number("min_spread_rev_per_s", pos);
+    m.finish();
+  }
   p.residual_low_upper_bound = res.boolean("low_upper_bound");
   p.residual_low_lower_bound = res.boolean("low_lower_bound");
   p.residual_low_static_span_rev = res.number("low_static_span_rev", config::Range::non_negative());

@@ -95,6 +95,53 @@ int ResidualDetector::judge_revisit(const CornerReading& r, double eol_keys_kN, 
   return bin;
 }
 
+bool ResidualDetector::judge_modulation(double residual_kN, double v, double t, int definition, double thr0_kN,
+                                        const MonitorParams& p) {
+  modulation_kN_ = std::numeric_limits<double>::quiet_NaN();
+  modulation_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
+  if (!p.modulation || !std::isfinite(residual_kN) || !std::isfinite(thr0_kN)) {
+    mod_definition_ = -1;
+    return false;
+  }
+  if (definition != mod_definition_ || t <= mod_time_s_ || t - mod_time_s_ > p.jump_max_gap_s) {
+    mod_ = ModulationSums{};
+    mod_definition_ = definition;
+  } else {
+    const double k = std::exp(-(t - mod_time_s_) / p.modulation_time_constant_s);
+    ModulationSums& m = mod_;
+    m.w *= k; m.v *= k; m.s *= k; m.vv *= k; m.vs *= k; m.r *= k; m.rv *= k; m.rs *= k; m.pos *= k;
+  }
+  mod_time_s_ = t;
+  const double s = v >= 0.0 ? 1.0 : -1.0;
+  ModulationSums& m = mod_;
+  m.w += 1.0; m.v += v; m.s += s; m.vv += v * v; m.vs += v * s; m.r += residual_kN; m.rv += residual_kN * v;
+  m.rs += residual_kN * s; m.pos += s > 0.0 ? 1.0 : 0.0;
+  // Spread and both ways: the fit's standstill value is between the two ways' samples.
+  const double mean_v = m.v / m.w;
+  const double var_v = m.vv / m.w - mean_v * mean_v;
+  const double spread = p.modulation_min_spread_rev_per_s;
+  constexpr double kLeastShare = 0.2;
+  if (var_v < spread * spread || m.pos < kLeastShare * m.w || m.w - m.pos < kLeastShare * m.w) return false;
+  // Normal equations [w v s; v vv vs; s vs w] [c a b]' = [r rv rs]' (s^2 = 1), by Cramer's rule.
+  const double A[3][3] = {{m.w, m.v, m.s}, {m.v, m.vv, m.vs}, {m.s, m.vs, m.w}};
+  const double y[3] = {m.r, m.rv, m.rs};
+  auto det3 = [](const double M[3][3]) {
+    return M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) - M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
+           M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0]);
+  };
+  const double d = det3(A);
+  if (!(std::abs(d) > 1e-9 * m.w * m.w * m.w * std::max(1.0, var_v))) return false;
+  double A0[3][3];
+  for (int i = 0; i < 3; ++i) {
+    A0[i][0] = y[i];
+    A0[i][1] = A[i][1];
+    A0[i][2] = A[i][2];
+  }
+  modulation_kN_ = det3(A0) / d;
+  modulation_threshold_kN_ = thr0_kN;
+  return std::abs(modulation_kN_) > thr0_kN;
+}
+
 void ResidualDetector::learn_revisit(int bin, double speed_rev_per_s, double dt_s, const MonitorParams& p) {
   if (bin < 0) return;
   RevisitBin& b = revisit_bins_[static_cast<std::size_t>(bin)];
@@ -215,9 +262,11 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
     change_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
     have_reference_ = false;  // restarts where the curve is trusted again
+    mod_definition_ = -1;
     return;
   }
   double thr = 0.0, change_thr = 0.0;
+  double thr0 = std::numeric_limits<double>::quiet_NaN();  // the level rule's threshold at standstill
   if (eol_here) {
     // The end-of-line curve where the keys are, with its band.
     const double eol_kN = eol_keys_kN;
@@ -230,10 +279,12 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       friction_band_kN *= p.eol_friction_model_share;
     }
     thr = eol_allowance_kN(p, p.eol_band_kN, friction_band_kN, eol_kN, r.speed_rev_per_s);
+    thr0 = eol_allowance_kN(p, p.eol_band_kN, friction_band_kN, eol_kN, 0.0);
     if (!eol_mode_) have_reference_ = false;
     eol_mode_ = true;
   } else if (!e.calibrated) {
     thr = p.uncalibrated_residual_threshold_kN;  // no end-of-line curve: the initial curve
+    thr0 = thr;
     eol_mode_ = false;
   } else {
     if (eol_) {
@@ -273,6 +324,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     // Unmodelled speed effects (viscous friction, sensor delay) grow with speed.
     // Beyond the speeds a force loop corrects at (its reaction to a step must stay visible).
     const double speed_kN = p.residual_speed_kN_per_rev_per_s * std::max(0.0, std::abs(r.speed_rev_per_s) - p.residual_speed_free_rev_per_s);
+    thr0 = thr;
     thr += speed_kN;
     if (eol_ && friction_known_ && p.calibrated_two_friction_models && p.calibrated_capped_by_eol) {
       // The residual nearest zero of the two friction models is never farther from zero than the
@@ -281,6 +333,9 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       const double eol_thr = eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_model_share * p.eol_friction_half_width_kN,
                                               eol_keys_kN, r.speed_rev_per_s);
       thr = std::max(p.residual_threshold_kN, std::min(thr, eol_thr));
+      const double eol_thr0 = eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_model_share * p.eol_friction_half_width_kN,
+                                               eol_keys_kN, 0.0);
+      thr0 = std::max(p.residual_threshold_kN, std::min(thr0, eol_thr0));
     }
     // (The change rule's speed allowance is added below, against the reference's speed.)
     if (eol_mode_) have_reference_ = false;
@@ -395,8 +450,11 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   hold_last_curve_kN_ = hold_curve_kN;
   bool revisit_over = false;
   const int revisit_bin = judge_revisit(r, eol_keys_kN, revisit_over, p);
+  const int definition = (eol_here ? 1 : 0) | (friction_known_ ? 2 : 0) | (e.calibrated ? 4 : 0);
+  const bool modulation_over = judge_modulation(residual_kN_, r.speed_rev_per_s, t, definition, thr0, p);
   const bool over = p.residual_findings && (std::abs(residual_kN_) > thr ||
-                                            (change_rule && std::abs(change_kN_) > change_thr) || hold_over || revisit_over);
+                                            (change_rule && std::abs(change_kN_) > change_thr) || hold_over ||
+                                            revisit_over || modulation_over);
   learn_revisit(over ? -1 : revisit_bin, r.speed_rev_per_s, revisit_dt_s, p);
   if (!over && !eol_here && e.calibrated && std::isfinite(ms_residual_kN2_) && std::isfinite(change_kN_)) {
     // Healthy: the corner's own residual statistics follow (never while suspected).

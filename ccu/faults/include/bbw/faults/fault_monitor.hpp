@@ -131,6 +131,18 @@ struct MonitorParams {
   double revisit_bin_rev = 0.05;
   int revisit_settle_samples = 5;
   double revisit_forget_s = 20.0;
+  // The modulation rule (twenty-second session): the level rule's threshold grows with speed
+  // (unmodelled viscous friction, sensor delay), so in ABS-like modulation at 5-8 rev/s a drift is
+  // over the threshold only around the reversals, never for residual_persist_s. Those effects go
+  // with the speed (and the keys' with its sign), a load-cell fault does not: over the last
+  // modulation_time_constant_s (exponentially weighted) the residual is fitted as c + a v +
+  // b sign(v), and c, the residual at standstill, is judged against the level rule's threshold at
+  // standstill. Only while the speeds spread by modulation_min_spread_rev_per_s (weighted standard
+  // deviation) or more, with at least a fifth of the weight each way; the fit restarts when the
+  // residual's definition changes.
+  bool modulation = true;
+  double modulation_time_constant_s = 0.2;
+  double modulation_min_spread_rev_per_s = 1.0;
   double eol_band_kN = 0.5;
   // The end-of-line test's accuracy, relative to the force: its reference load cell and the
   // temperature compensation (1 %; in simulation the end-of-line curve is the plant's own, so
@@ -491,6 +503,8 @@ class FaultMonitor {
   double last_hold_threshold_kN() const { return residual_.hold_threshold_kN(); }
   double last_revisit_change_kN() const { return residual_.revisit_change_kN(); }
   double last_revisit_threshold_kN() const { return residual_.revisit_threshold_kN(); }
+  double last_modulation_kN() const { return residual_.modulation_kN(); }
+  double last_modulation_threshold_kN() const { return residual_.modulation_threshold_kN(); }
   // A residual disagreement is under way but not yet confirmed: the calibrator must not learn
   // from these samples (CornerSupervisor holds its fits).
   bool residual_suspect() const { return residual_.suspect(); }

@@ -5,9 +5,11 @@
 // (MonitorParams). A residual beyond its threshold, or (calibrated) a change against its own
 // recent level beyond the change threshold, or (with an end-of-line curve) a change against its
 // level where the drive has been before (the revisit rule) or since a hold settled (the hold rule),
-// that persists is a disagreement; isolation names the channel that explains it (a frozen position: ResolverStuck;
-// a frozen load cell: LoadCellStuck; a recent position jump: ResolverOffset; else
-// LoadCellOffset). Feeds the noise detector with every residual.
+// or, in a modulation, its fitted value at standstill beyond the threshold at standstill (the
+// modulation rule), that persists is a disagreement; isolation names the channel that explains it
+// (a frozen position: ResolverStuck; a frozen load cell: LoadCellStuck; a recent position jump:
+// ResolverOffset; else LoadCellOffset). Feeds the noise detector with every residual above the
+// trusted range, and below it (released) the load cell's own differences.
 #pragma once
 
 #include <cmath>
@@ -63,6 +65,7 @@ class ResidualDetector {
     hold_sum_kN_ = 0.0;
     static_ref_ = false;
     static_count_ = 0;
+    mod_definition_ = -1;
   }
   // The position's state (the end-of-line friction model, the play, the sweep) before a resolver
   // jump: taken back once the jump is confirmed as an offset, from where the positions less the
@@ -111,6 +114,8 @@ class ResidualDetector {
   // has no level yet or the rule is off).
   double revisit_change_kN() const { return revisit_change_kN_; }
   double revisit_threshold_kN() const { return revisit_threshold_kN_; }
+  double modulation_kN() const { return modulation_kN_; }
+  double modulation_threshold_kN() const { return modulation_threshold_kN_; }
 
  private:
   bool suspect_ = false;
@@ -207,6 +212,18 @@ class ResidualDetector {
   double prev_lc_time_s_ = 0.0;
   double revisit_change_kN_ = std::numeric_limits<double>::quiet_NaN();
   double revisit_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
+  // The modulation rule (MonitorParams::modulation): exponentially weighted sums of the fit.
+  struct ModulationSums {
+    double w = 0, v = 0, s = 0, vv = 0, vs = 0, r = 0, rv = 0, rs = 0, pos = 0;
+  };
+  ModulationSums mod_;
+  int mod_definition_ = -1;
+  double mod_time_s_ = 0.0;
+  double modulation_kN_ = std::numeric_limits<double>::quiet_NaN();
+  double modulation_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
+  // Adds the sample and judges the fit's residual at standstill against thr0_kN.
+  bool judge_modulation(double residual_kN, double speed_rev_per_s, double t, int definition, double thr0_kN,
+                        const MonitorParams& p);
   void clear_revisit() {
     for (RevisitBin& b : revisit_bins_) b = RevisitBin{};
   }
