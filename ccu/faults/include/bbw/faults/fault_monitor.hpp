@@ -364,11 +364,11 @@ struct MonitorParams {
   // + unexplained_relative |need|. Pulling: need - make > the same + |need| (a gear in its
   // backlash gap carries none of the load the load cell reads). For unexplained_persist_s:
   // ActuatorLost.
-  // Pulling, also: what the pull needs (the load carried or not, and the drive's friction against
-  // it) is less than torque_lost_threshold of the pull, as pushing (twenty-second session). A
-  // partial torque loss the loop absorbs pulls harder than a healthy drive, not without answer
-  // (tuning seed 1401 run 341: a 72 % loss braking a release at 2 kN pulled 3.5 times its need
-  // and was named lost).
+  // Pulling, also: what the pull needs (the drive's friction against it and, on a caliper with
+  // play, the load carried or not) is less than torque_lost_threshold of the pull, as pushing
+  // (twenty-second session). A partial torque loss the loop absorbs pulls harder than a healthy
+  // drive, not without answer (tuning seed 1401 run 341: a 72 % loss braking an apply at 2 kN
+  // pulled 3.5 times its need and was named lost).
   bool unexplained_pull_fraction = true;
   plant::TransmissionParams drive;            // the drive's friction (the plant's transmission: plant::drive_friction_Nm)
   double unexplained_margin_Nm = 0.1;
