@@ -1668,9 +1668,35 @@ TEST(FaultMonitor, AHoldWhoseKeysKeptSlippingOneWayNeedsNoFrictionAllowance) {
               without.detected_s);
 }
 
-// The revisit rule: a calibrated corner modulated like an ABS (6 Hz, +-0.15 rev about 4.5 rev)
-// whose clamp curve is 3 % stiffer than its end-of-line one (within the band, but 0.6 kN of it at
-// 20 kN), its calibrator right about the friction. A -1 kN/s load-cell drift from 4 s: at speed
+// A calibrated corner modulated like an ABS (6 Hz, +-0.15 rev about 4.5 rev, up to 5.7 rev/s),
+// its calibrator right about the friction: the clamp curve `stiffness` x the end-of-line one, the
+// load cell `speed_kN_per_rev_per_s` x the speed off the clamp force (a sensor delay, viscous
+// keys), and a load-cell drift from 4 s. Returns the load cell's diagnosis at 7 s.
+namespace {
+Diagnosis modulated_corner(const MonitorParams& p, double stiffness, double speed_kN_per_rev_per_s, double drift_kN_per_s) {
+  EolCaliper caliper{p};
+  auto& [eol, keys, T] = caliper;
+  FaultMonitor m(p, Target::FR);
+  SampleGuard g{MonitorParams{}.guard};
+  for (int n = 1; n < 7000; ++n) {
+    const double t = 0.001 * n;
+    const double w = 2.0 * M_PI * 6.0;
+    const double speed = t >= 1.0 ? 0.15 * w * std::cos(w * (t - 1.0)) : 4.5;
+    const double x = t < 1.0 ? 4.5 * t : 4.5 + 0.15 * std::sin(w * (t - 1.0));
+    const double friction_kN = keys.step(x);
+    const double drift_kN = t > 4.0 ? drift_kN_per_s * (t - 4.0) : 0.0;
+    const double clamp_kN = stiffness * eol.force_kN(x, T, 0.0);
+    const double lc = clamp_kN + friction_kN + speed_kN_per_rev_per_s * speed + drift_kN + 0.03 * ((n % 5) - 2);
+    const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
+    const auto e = fitted(t > 0.5, lc, friction_kN, clamp_kN);
+    m.update(r, g.check(r), &e, e.force_kN, t);
+  }
+  return m.diagnosis(Part::LoadCell);
+}
+}  // namespace
+
+// The revisit rule: the modulated corner above, its clamp curve 3 % stiffer than its end-of-line
+// one (within the band, but 0.6 kN of it at 20 kN). A -1 kN/s load-cell drift from 4 s: at speed
 // the level rule's allowance grows by 0.3 kN per rev/s and the residual starts 0.6 kN up, so the
 // level rule finds the drift only after its window (4 s + 1 kN / 1 kN/s + 0.5 s); where the
 // drive has been before, the residual has kept its level within 0.1 kN, and the drift shows
@@ -1680,26 +1706,7 @@ TEST(FaultMonitor, TheRevisitRuleFindsADriftWhereTheDriveHasBeenBefore) {
     MonitorParams p = eol_params(1.5, false);
     p.revisit = revisit;
     p.modulation = false;  // the revisit rule alone (the modulation rule's test is below)
-    EolCaliper caliper{p};
-    auto& [eol, keys, T] = caliper;
-    FaultMonitor m(p, Target::FR);
-    SampleGuard g{MonitorParams{}.guard};
-    double x = 0.0;
-    for (int n = 1; n < 7000; ++n) {
-      const double t = 0.001 * n;
-      const double w = 2.0 * M_PI * 6.0;
-      double speed = 4.5;
-      if (t >= 1.0) speed = 0.15 * w * std::cos(w * (t - 1.0));
-      x = t < 1.0 ? 4.5 * t : 4.5 + 0.15 * std::sin(w * (t - 1.0));
-      const double friction_kN = keys.step(x);
-      const double drift_kN = t > 4.0 ? drift_kN_per_s * (t - 4.0) : 0.0;
-      const double clamp_kN = 1.03 * eol.force_kN(x, T, 0.0);
-      const double lc = clamp_kN + friction_kN + drift_kN + 0.03 * ((n % 5) - 2);
-      const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
-      const auto e = fitted(t > 0.5, lc, friction_kN, clamp_kN);
-      m.update(r, g.check(r), &e, e.force_kN, t);
-    }
-    return m.diagnosis(Part::LoadCell);
+    return modulated_corner(p, 1.03, 0.0, drift_kN_per_s);
   };
   const double window_end_s = 4.0 + 1.0 / 1.0 + 0.5;
   const auto healthy = run(true, 0.0);
@@ -1718,35 +1725,18 @@ TEST(FaultMonitor, TheRevisitRuleFindsADriftWhereTheDriveHasBeenBefore) {
               with.detected_s, without.present ? "named at" : "not named;", without.detected_s, up.detected_s);
 }
 
-// The modulation rule: an ABS-like corner as above (6 Hz, +-0.15 rev about 4.5 rev, up to 5.7
-// rev/s), its clamp curve the end-of-line one, its load cell reading 0.1 kN per rev/s of speed off
-// the clamp force (a sensor delay, viscous keys), the revisit rule off. The level rule's allowance
-// grows by 0.3 kN per rev/s beyond 3 rev/s, so a -1 kN/s drift from 4 s is over it only around the
-// reversals, for less than its persistence, until 0.13 s after its window. Fitted as c + a v + b sign(v) over the last 0.2 s, the residual
-// at standstill is judged against the threshold at standstill: named 0.2 s inside it, either way.
+// The modulation rule: the modulated corner above, its clamp curve the end-of-line one, its load
+// cell 0.1 kN per rev/s of speed off the clamp force, the revisit rule off. The level rule's
+// allowance grows by 0.3 kN per rev/s beyond 3 rev/s, so a -1 kN/s drift from 4 s is over it only
+// around the reversals, for less than its persistence, until 0.13 s after its window. Fitted as
+// c + a v + b sign(v) over the last 0.2 s, the residual at standstill is judged against the
+// threshold at standstill: named 0.2 s inside it, either way.
 TEST(FaultMonitor, TheModulationRuleJudgesTheResidualAtStandstill) {
   auto run = [](bool modulation, double drift_kN_per_s) {
     MonitorParams p = eol_params(1.5, false);
     p.revisit = false;
     p.modulation = modulation;
-    EolCaliper caliper{p};
-    auto& [eol, keys, T] = caliper;
-    FaultMonitor m(p, Target::FR);
-    SampleGuard g{MonitorParams{}.guard};
-    for (int n = 1; n < 7000; ++n) {
-      const double t = 0.001 * n;
-      const double w = 2.0 * M_PI * 6.0;
-      const double speed = t >= 1.0 ? 0.15 * w * std::cos(w * (t - 1.0)) : 4.5;
-      const double x = t < 1.0 ? 4.5 * t : 4.5 + 0.15 * std::sin(w * (t - 1.0));
-      const double friction_kN = keys.step(x);
-      const double drift_kN = t > 4.0 ? drift_kN_per_s * (t - 4.0) : 0.0;
-      const double clamp_kN = eol.force_kN(x, T, 0.0);
-      const double lc = clamp_kN + friction_kN + 0.1 * speed + drift_kN + 0.03 * ((n % 5) - 2);
-      const auto r = live_reading(n, t, x, speed + 0.004 * ((n % 3) - 1), lc, p);
-      const auto e = fitted(t > 0.5, lc, friction_kN, clamp_kN);
-      m.update(r, g.check(r), &e, e.force_kN, t);
-    }
-    return m.diagnosis(Part::LoadCell);
+    return modulated_corner(p, 1.0, 0.1, drift_kN_per_s);
   };
   const double window_end_s = 4.0 + 1.0 / 1.0 + 0.5;
   const auto healthy = run(true, 0.0);
