@@ -39,6 +39,7 @@
 #include "bbw/faults/schedule_yaml.hpp"
 #include "bbw/node/command_plan.hpp"
 #include "bbw/runtime/failover_stats.hpp"
+#include "failover_starved.hpp"
 #include "failover_summary.hpp"
 #include "netns_support.hpp"
 
@@ -208,7 +209,12 @@ void print(const std::string& what, const bbw::launch::FailoverResult& r) {
             << " owners_at_end=" << r.owners_at_end << std::endl;
 }
 
-void link_cut(const std::string& mode, int domain) {
+// One run of the link cut; `again` is set (and nothing judged) when a realtime run before the
+// last attempt was decided by the machine (failover_starved.hpp: both CCUs stalled at once, or
+// the standby across the takeover; a ctest pass saw both CCUs silent together for 19 ms and every
+// corner 30-38 ms without a command, past its 20 ms watchdog), as the failover runs over one
+// host do.
+void link_cut_once(const std::string& mode, int domain, int attempt, bool& again) {
   Cluster c(domain, "link_cut_" + mode);
   if (const std::string why = c.build(); !why.empty()) GTEST_SKIP() << why;
   const std::string scenario = "config/scenarios/faults/ccu_failover_link_cut.yaml";
@@ -232,11 +238,17 @@ void link_cut(const std::string& mode, int domain) {
   const double hold_s = mode == "lockstep" ? std::min(0.05, *cut.duration_s) : *cut.duration_s;
   const bool primary_ended = c.primary_ended_before(Clock::now() + std::chrono::milliseconds(static_cast<int>(1e3 * hold_s)));
   ASSERT_EQ(set_link(c.ns(kPrimary), "bbw0", true, up_before_s, up_after_s), "");
-  EXPECT_FALSE(primary_ended) << c.logs();
   const std::string bad = c.wait_all(60s);
-  EXPECT_EQ(bad, "") << c.logs();
 
   auto in = bbw::launch::load_failover_input(loaded.scenario, c.out(), mode == "lockstep");
+  if (const std::string starved = mode == "realtime" && attempt < 3 ? bbw::system_test::ccus_starved(in.primary, in.standby, down_mono_s) : "";
+      !starved.empty()) {
+    std::cout << "[ NOTE     ] run " << attempt << " of the link cut not judged: " << starved << "; running it again" << std::endl;
+    again = true;
+    return;
+  }
+  EXPECT_FALSE(primary_ended) << c.logs();
+  EXPECT_EQ(bad, "") << c.logs();
   in.failure = "link_cut";
   in.failed_mono_s = down_mono_s;
   // Realtime: the primary's simulated time at the cut. Lockstep: simulated time is the corners'
@@ -290,6 +302,14 @@ void link_cut(const std::string& mode, int domain) {
       EXPECT_GT(primary.size(), 1000u) << corner;
       EXPECT_TRUE(primary == standby) << "ccu_" << corner << ".csv: the two CCUs differ\n" << c.logs();
     }
+  }
+}
+
+void link_cut(const std::string& mode, int domain) {
+  for (int attempt = 1;; ++attempt) {
+    bool again = false;
+    link_cut_once(mode, domain, attempt, again);
+    if (!again || ::testing::Test::HasFatalFailure()) return;
   }
 }
 

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "bbw/runtime/failover_stats.hpp"
+#include "failover_starved.hpp"
 #include "system_test_support.hpp"
 
 namespace {
@@ -66,36 +67,13 @@ std::string fastdds_abort(const std::string& out_dir) {
   return "";
 }
 
-// A realtime standby run that the machine, not the CCUs, decided, from the CCUs' own stall
-// intervals (their failover stats: their sends further apart than the corners' deadline): the
-// standby stalled within the takeover window (25 ms from the primary's failure, the goals'
-// longest figure), or both CCUs stalled at once before it (the corners then hear nobody, and no
-// standby can help). Returns what happened, or "" (also when the run has no stats to tell).
+// A realtime standby run that the machine, not the CCUs, decided (failover_starved.hpp), from
+// the stats under out; "" also when the run has no stats to tell.
 std::string ccus_starved(const std::string& out) {
-  namespace fs = std::filesystem;
   const std::string primary_file = out + "/ccu_failover.stats", standby_file = out + "/standby/ccu_failover.stats";
   if (!fs::exists(primary_file) || !fs::exists(standby_file)) return "";
   const auto primary = bbw::runtime::load_ccu_failover(primary_file);
-  const auto standby = bbw::runtime::load_ccu_failover(standby_file);
-  auto ms = [](double s) { return std::to_string(1e3 * s); };
-  if (primary.failed_mono_s >= 0.0) {
-    const double from = primary.failed_mono_s, to = from + 0.025;
-    for (const auto& st : standby.stall_intervals) {
-      if (st.to_mono_s >= from && st.from_mono_s <= to) {
-        return "the standby stalled from " + ms(st.from_mono_s - from) + " to " + ms(st.to_mono_s - from) +
-               " ms after the primary's failure (starved of the CPU)";
-      }
-    }
-  }
-  for (const auto& a : primary.stall_intervals) {
-    for (const auto& b : standby.stall_intervals) {
-      if (a.to_mono_s >= b.from_mono_s && b.to_mono_s >= a.from_mono_s) {
-        return "both CCUs stalled at once, " + ms(std::max(a.from_mono_s, b.from_mono_s) - primary.t0_mono_s) + " to " +
-               ms(std::min(a.to_mono_s, b.to_mono_s) - primary.t0_mono_s) + " ms into the run (starved of the CPU)";
-      }
-    }
-  }
-  return "";
+  return bbw::system_test::ccus_starved(primary, bbw::runtime::load_ccu_failover(standby_file), primary.failed_mono_s);
 }
 
 double num(const std::map<std::string, std::string>& m, const std::string& k) {
