@@ -182,6 +182,10 @@ ControllerOutput LocalController::update_force(double force_command_kN, const Co
     return update_position(PositionReference{p_.release_position_rev, 0.0, 0.0}, in, dt_s);
   }
   s_.releasing = false;
+  if (p_.feedback_switch_restart && in.feedback_switched) {
+    s_.stiffness.started = false;
+    s_.force_integral_kN_s = 0.0;
+  }
   if (resolver_frozen(in)) {
     s_.hold_s = 0.0;
     s_.pulse_s = -1.0;

@@ -168,6 +168,7 @@ corner_unit::ControllerParams read_controller(Reader& c) {
   p.release_position_rev = c.number_or("release_position_rev", p.release_position_rev, Range::closed(-2.0, 12.0));
   p.load_feedforward = c.boolean_or("load_feedforward", p.load_feedforward);
   p.force_home_limit = c.boolean_or("force_home_limit", p.force_home_limit);
+  p.feedback_switch_restart = c.boolean_or("feedback_switch_restart", p.feedback_switch_restart);
   p.force_home_margin_rev = c.number_or("force_home_margin_rev", p.force_home_margin_rev, Range::closed(0.0, 2.0));
   p.curve_trusted_min_rev = c.number_or("curve_trusted_min_rev", p.curve_trusted_min_rev, Range::closed(-2.0, 12.0));
   p.stiffness_estimate = c.boolean_or("stiffness_estimate", p.stiffness_estimate);

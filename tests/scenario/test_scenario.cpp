@@ -1,10 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <string>
+#include <tuple>
 
 #include "bbw/plant/clamp_curve.hpp"
 #include "bbw/plant/params_yaml.hpp"
@@ -426,6 +429,78 @@ TEST(CornerSim, AForceLoopReadingTooMuchStopsAtTheReleasedHome) {
   const auto [free_rev, free_A] = run(false);
   EXPECT_NEAR(free_rev, s.plant.transmission.retracted_stop_rev, 1e-6);
   EXPECT_LT(free_A, -30.0);
+}
+
+// A corner holding 35 kN on its load cell, which then reads 1.5 kN low, is moved 5 ms later to
+// curve feedback (the CCU's reaction to the load-cell fault) with a curve that reads 13 % high (tune_bias run 94: 4.7 kN at 37 kN), then
+// released to 3 kN. With controller.feedback_switch_restart the loop restarts its stiffness
+// estimate and force integral at the switch and the release stops on the pads. Without it the
+// 6 kN step at the switch, after the loop had pushed on 1 thousandth of a rev, read as a caliper 80 times stiffer: the loop released
+// at a fraction of a rev per second, wound its force integral, and that integral carried the
+// release behind the pads' contact at the speed limit.
+TEST(CornerSim, AFeedbackSwitchRestartsTheForceLoopsStiffnessAndIntegral) {
+  auto s = scenario::load_scenario(source_dir() + "/config/scenarios/vehicle_stop.yaml");
+  ASSERT_TRUE(s.controller.feedback_switch_restart);
+  const plant::ClampCurve eol(s.plant.curve);
+  const double temperature_C = s.corners[0].conditions.temperature_C;
+  // The cubic through 1.13 x the end-of-line curve at four positions from 1 rev to past the hold.
+  const double contact_rev = eol.contact_rev(temperature_C, 0.0);
+  double m[4][5];
+  for (int i = 0; i < 4; ++i) {
+    const double x = contact_rev + 1.0 + 2.0 * i;
+    m[i][0] = x * x * x;
+    m[i][1] = x * x;
+    m[i][2] = x;
+    m[i][3] = 1.0;
+    m[i][4] = 1.13 * eol.force_kN(x, temperature_C, 0.0);
+  }
+  for (int k = 0; k < 4; ++k) {
+    for (int i = k + 1; i < 4; ++i) {
+      const double f = m[i][k] / m[k][k];
+      for (int j = k; j < 5; ++j) m[i][j] -= f * m[k][j];
+    }
+  }
+  double coef[4];
+  for (int k = 3; k >= 0; --k) {
+    double v = m[k][4];
+    for (int j = k + 1; j < 4; ++j) v -= m[k][j] * coef[j];
+    coef[k] = v / m[k][k];
+  }
+  const scenario::CurveEstimate high{coef[0], coef[1], coef[2], coef[3]};
+  struct Biased : scenario::SensorHook {
+    void apply(plant::Measurement& m) override { m.force_internal_kN -= 1.5; }
+  };
+  const auto run = [&](bool restart) {
+    s.controller.feedback_switch_restart = restart;
+    scenario::CornerSim sim(s, 0);
+    scenario::ExternalInputs ext;
+    ext.curve = high;
+    ext.feedback = corner_unit::ForceFeedback::LoadCell;
+    ext.force_command_kN = 35.0;
+    for (int i = 0; i < 1000; ++i) sim.step(s.plant_dt_s, ext);
+    const double held_kN = sim.last().force_true_kN;
+    // The load cell's bias the CCU reacts to: the loop pushes on for the 5 ms until the switch.
+    Biased low;
+    ext.sensor_hook = &low;
+    for (int i = 0; i < 5; ++i) sim.step(s.plant_dt_s, ext);
+    ext.feedback = corner_unit::ForceFeedback::Curve;
+    for (int i = 0; i < 300; ++i) sim.step(s.plant_dt_s, ext);
+    double lowest_rev = 1e9;
+    for (int i = 0; i < 600; ++i) {
+      ext.force_command_kN = std::max(3.0, 35.0 - 0.32 * i);  // 320 kN/s down to 3 kN
+      lowest_rev = std::min(lowest_rev, sim.step(s.plant_dt_s, ext).position_true_rev);
+    }
+    return std::tuple{held_kN, lowest_rev, sim.last().force_true_kN};
+  };
+  const auto [held_kN, lowest_rev, end_kN] = run(true);
+  std::cout << "[ MEASURED ] with the restart: held " << held_kN << " kN, lowest " << lowest_rev << " rev (contact "
+            << contact_rev << "), end " << end_kN << " kN" << std::endl;
+  EXPECT_NEAR(held_kN, 35.0, 1.0);  // the load cell reads the keys' friction too
+  EXPECT_GT(lowest_rev, contact_rev);
+  EXPECT_NEAR(end_kN, 3.0 / 1.13, 0.5);
+  const auto [held_off_kN, lowest_off_rev, end_off_kN] = run(false);
+  std::cout << "[ MEASURED ] without: lowest " << lowest_off_rev << " rev, end " << end_off_kN << " kN" << std::endl;
+  EXPECT_LT(lowest_off_rev, contact_rev - 0.3);
 }
 
 // A cubic without a local minimum that reads 2 kN at the released home (a line, 2 + 3 x): below

@@ -49,6 +49,14 @@ struct ControllerParams {
   // onto its retracted stop.
   bool force_home_limit = true;
   double force_home_margin_rev = 0.1;
+  // When the force feedback's source changes (ControllerInputs::feedback_switched: a CCU fault
+  // reaction moves the loop from the load cell to the curve or back), the force loop restarts its
+  // stiffness estimate and its force integral: the step between the two sources is no travel of
+  // the caliper, and neither the slope nor the integral of the old source's error fits the new
+  // one. Without it the step (6 kN at 6.36 rev, no motion) read as a 1200 kN/rev caliper; the
+  // loop, its gain cut 80-fold, released at 0.2 rev/s and wound its integral, which then drove
+  // the release from the hard stop 0.6 rev behind the pads' contact (tune_bias run 94).
+  bool feedback_switch_restart = true;
   // Curve feedback (the CCU's calibrated cubic): below this position, or below the cubic's local
   // minimum if that is higher, the estimate is the end-of-line curve scaled to meet the cubic
   // there (a cubic cannot bend to the pads' contact; the CCU's monitor trusts it from 1 rev up).
@@ -122,6 +130,7 @@ struct ControllerInputs {
   double speed_rev_per_s = 0.0;        // resolver speed
   double force_feedback_kN = 0.0;      // force-loop feedback (select_force)
   double load_force_kN = 0.0;          // axial load for the current feedforward (load cell)
+  bool feedback_switched = false;      // force_feedback_kN comes from another source than last step
 };
 
 // The regression of feedback force on position behind k_seen (sums weighted by the travel).
