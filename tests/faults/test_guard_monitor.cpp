@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <random>
@@ -1693,6 +1694,26 @@ Diagnosis modulated_corner(const MonitorParams& p, double stiffness, double spee
   }
   return m.diagnosis(Part::LoadCell);
 }
+
+// What a drift rule on the modulated corner must show: `run(rule_on, drift_kN_per_s)` gives the
+// load cell's diagnosis. Healthy, nothing; a -1 kN/s drift from 4 s named inside its window
+// (4 s + 1 kN / 1 kN/s + 0.5 s) with the rule and not without it; and a +1 kN/s drift too.
+void expect_drift_rule(const char* rule, const std::function<Diagnosis(bool, double)>& run) {
+  const double window_end_s = 4.0 + 1.0 / 1.0 + 0.5;
+  const auto healthy = run(true, 0.0);
+  EXPECT_FALSE(healthy.present) << rule << ": " << to_string(healthy.finding) << " at " << healthy.detected_s;
+  const auto without = run(false, -1.0);
+  EXPECT_TRUE(!without.present || without.detected_s > window_end_s) << rule << ": " << without.detected_s;
+  const auto with = run(true, -1.0);
+  EXPECT_EQ(with.finding, Finding::LoadCellOffset) << rule << ": " << to_string(with.finding);
+  EXPECT_GT(with.detected_s, 4.0) << rule;
+  EXPECT_LT(with.detected_s, window_end_s) << rule;
+  const auto up = run(true, 1.0);
+  EXPECT_EQ(up.finding, Finding::LoadCellOffset) << rule << ": " << to_string(up.finding);
+  EXPECT_LT(up.detected_s, window_end_s) << rule;
+  std::printf("%s: drift -1 kN/s from 4 s named at %.3f s (without it: %s %.3f s), +1 kN/s at %.3f s\n", rule,
+              with.detected_s, without.present ? "named at" : "not named;", without.detected_s, up.detected_s);
+}
 }  // namespace
 
 // The revisit rule: the modulated corner above, its clamp curve 3 % stiffer than its end-of-line
@@ -1708,21 +1729,7 @@ TEST(FaultMonitor, TheRevisitRuleFindsADriftWhereTheDriveHasBeenBefore) {
     p.modulation = false;  // the revisit rule alone (the modulation rule's test is below)
     return modulated_corner(p, 1.03, 0.0, drift_kN_per_s);
   };
-  const double window_end_s = 4.0 + 1.0 / 1.0 + 0.5;
-  const auto healthy = run(true, 0.0);
-  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
-  const auto without = run(false, -1.0);
-  EXPECT_TRUE(!without.present || without.detected_s > window_end_s) << without.detected_s;
-  const auto with = run(true, -1.0);
-  EXPECT_EQ(with.finding, Finding::LoadCellOffset) << to_string(with.finding);
-  EXPECT_GT(with.detected_s, 4.0);
-  EXPECT_LT(with.detected_s, window_end_s);
-  // A drift the other way, too.
-  const auto up = run(true, 1.0);
-  EXPECT_EQ(up.finding, Finding::LoadCellOffset) << to_string(up.finding);
-  EXPECT_LT(up.detected_s, window_end_s);
-  std::printf("revisit rule: drift -1 kN/s from 4 s named at %.3f s (without it: %s %.3f s), +1 kN/s at %.3f s\n",
-              with.detected_s, without.present ? "named at" : "not named;", without.detected_s, up.detected_s);
+  expect_drift_rule("revisit rule", run);
 }
 
 // The modulation rule: the modulated corner above, its clamp curve the end-of-line one, its load
@@ -1738,20 +1745,7 @@ TEST(FaultMonitor, TheModulationRuleJudgesTheResidualAtStandstill) {
     p.modulation = modulation;
     return modulated_corner(p, 1.0, 0.1, drift_kN_per_s);
   };
-  const double window_end_s = 4.0 + 1.0 / 1.0 + 0.5;
-  const auto healthy = run(true, 0.0);
-  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
-  const auto without = run(false, -1.0);
-  EXPECT_TRUE(!without.present || without.detected_s > window_end_s) << without.detected_s;
-  const auto with = run(true, -1.0);
-  EXPECT_EQ(with.finding, Finding::LoadCellOffset) << to_string(with.finding);
-  EXPECT_GT(with.detected_s, 4.0);
-  EXPECT_LT(with.detected_s, window_end_s);
-  const auto up = run(true, 1.0);
-  EXPECT_EQ(up.finding, Finding::LoadCellOffset) << to_string(up.finding);
-  EXPECT_LT(up.detected_s, window_end_s);
-  std::printf("modulation rule: drift -1 kN/s from 4 s named at %.3f s (without it: %s %.3f s), +1 kN/s at %.3f s\n",
-              with.detected_s, without.present ? "named at" : "not named;", without.detected_s, up.detected_s);
+  expect_drift_rule("modulation rule", run);
 }
 
 // The lost rules judge a drive only once its torque filters have settled (three filter time
