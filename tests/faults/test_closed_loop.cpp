@@ -738,12 +738,26 @@ TEST(ClosedLoopIssue14, ATotalLossWhileApplyingAtSpeedIsNamedByTheBrakingRule) {
 // A 59 % torque loss while the demand comes down slowly, then a load-cell bias on the same corner
 // 0.121 s later (stress seed 1406 run 112): the motor holds the screw back against the load, and
 // the weaker motor needs more current for it. The torque-loss rule while braking at speed names
-// the loss before the bias; without it the loss is not named in its window (the bias takes the
-// load cell the other rules judge it by).
+// the loss 58 ms in, before the bias. Without it the loss was named wrongly (the bias took the
+// load cell the other rules judge it by: load_cell_offset); since the corner restarts its force
+// loop at the switch to curve feedback (controller.feedback_switch_restart), the loop on the
+// curve after the bias shows the loss to the other rules, which name it 306 ms in, within its
+// 1 s window but five times later.
 TEST(ClosedLoopIssue14, ATorqueLossInASlowReleaseIsNamedWhileTheMotorHoldsBack) {
-  expect_both_named_fault_k_only_with_the_rule("config/scenarios/faults/torque_loss_then_a_load_cell_bias_in_a_slow_release.yaml", 0,
-                                               "the torque-loss rule while braking at speed",
-                                               [](MonitorParams& m) { m.torque_loss_braking_threshold = 0.0; });
+  const auto fs = load("config/scenarios/faults/torque_loss_then_a_load_cell_bias_in_a_slow_release.yaml");
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 2u);
+  for (const auto& o : r.outcomes) EXPECT_TRUE(o.detected) << to_string(o.fault.type) << " " << to_string(o.diagnosis);
+  EXPECT_EQ(r.faults_raised(), 2u);
+  EXPECT_LT(r.outcomes[0].latency_ms, 100.0);
+  auto opts = default_options();
+  opts.monitor.torque_loss_braking_threshold = 0.0;
+  const auto base = run_closed_loop(fs, opts);
+  ASSERT_EQ(base.outcomes.size(), 2u);
+  EXPECT_TRUE(!base.outcomes[0].detected || base.outcomes[0].latency_ms > 200.0) << base.outcomes[0].latency_ms;
+  EXPECT_TRUE(base.outcomes[1].detected);
+  std::printf("torque_loss with the torque-loss rule while braking at speed: named after %.0f ms; without: %s after %.0f ms\n",
+              r.outcomes[0].latency_ms, to_string(base.outcomes[0].diagnosis), base.outcomes[0].diagnosis_latency_ms);
 }
 
 // A total loss 0.1 s after a resolver offset on the same corner (tuning seed 1403 run 780): the
@@ -825,14 +839,16 @@ TEST(ClosedLoopIssue14, AfterADropoutAcrossAReversalTheFrictionModelStillKnowsIt
   }
 }
 
-// A corner driven on its initial curve after a load-cell finding (13 % high on this caliper)
-// backs its 37 kN hold off slower than its loop asks. With the controller option
-// force_integral_max_speed_error_rev_per_s (2 rev/s) its force integral does not learn while the
-// rotor cannot follow its speed reference, so the release to 3 kN stops at the pads: no actuator
-// finding and the brake never off while 2 kN or more is commanded. With the shipped default
-// (learning regardless; tuning seed 1408 run 94) the release runs 1.9 rev past the pads and the
-// CCU names the healthy actuator actuator_tracking: a known, open defect (docs/plant.md).
-TEST(ClosedLoopIssue14, AReleaseOnTheCurveAfterALoadCellFindingStopsAtThePadsWithTheIntegralOption) {
+// A corner driven on its initial curve after a load-cell finding (13 % high on this caliper,
+// tuning seed 1408 run 94). The switch from the load cell to the curve steps the feedback by 6 kN
+// after the loop had pushed on 1 mrev against the bias: read as the caliper's stiffness, 1200
+// kN/rev, it cut the loop's gain 80-fold, the hold backed off at 0.2-0.8 rev/s and the force
+// integral learnt the error all the while; the release to 3 kN then ran 1.9 rev past the pads and
+// the CCU named the healthy actuator actuator_tracking. With the shipped defaults the loop
+// restarts its stiffness estimate and integral at the switch (controller.feedback_switch_restart):
+// no actuator finding and the brake never off while 2 kN or more is commanded. The older option
+// force_integral_max_speed_error_rev_per_s (2 rev/s, off by default) also prevents it alone.
+TEST(ClosedLoopIssue14, AReleaseOnTheCurveAfterALoadCellFindingStopsAtThePads) {
   auto fs = load("config/scenarios/faults/load_cell_bias_in_hard_stop_then_release_on_the_curve.yaml");
   const auto fr = [](const LoopResult& r) { return actuator(r, 1); };
   const auto off_s = [](const LoopResult& r) {
@@ -845,18 +861,24 @@ TEST(ClosedLoopIssue14, AReleaseOnTheCurveAfterALoadCellFindingStopsAtThePadsWit
     }
     return s;
   };
-  // The shipped default (0: off) winds up; the option on (2 rev/s) does not.
-  const auto wound = run_closed_loop(fs, default_options());
-  fs.scenario.controller.force_integral_max_speed_error_rev_per_s = 2.0;
+  ASSERT_TRUE(fs.scenario.controller.feedback_switch_restart);
+  ASSERT_EQ(fs.scenario.controller.force_integral_max_speed_error_rev_per_s, 0.0);
+  const auto expect_stops_at_the_pads = [&](const LoopResult& r, const char* what) {
+    ASSERT_EQ(r.outcomes.size(), 1u) << what;
+    EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << what;
+    EXPECT_FALSE(fr(r).present) << what << ": " << to_string(fr(r).finding) << " at " << fr(r).detected_s;
+    EXPECT_EQ(r.faults_raised(), 1u) << what;
+    EXPECT_LT(off_s(r), 0.02) << what;
+  };
   const auto r = run_closed_loop(fs, default_options());
-  ASSERT_EQ(r.outcomes.size(), 1u);
-  EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct);
-  EXPECT_FALSE(fr(r).present) << to_string(fr(r).finding) << " at " << fr(r).detected_s;
-  EXPECT_EQ(r.faults_raised(), 1u);
-  EXPECT_LT(off_s(r), 0.02);
+  expect_stops_at_the_pads(r, "shipped");
+  fs.scenario.controller.feedback_switch_restart = false;
+  const auto wound = run_closed_loop(fs, default_options());
   EXPECT_GT(off_s(wound), 0.1);
   ASSERT_TRUE(fr(wound).present);
-  std::printf("brake off while >= 2 kN commanded: %.0f ms; with the integral learning regardless %.0f ms and %s at %.3f s\n",
+  fs.scenario.controller.force_integral_max_speed_error_rev_per_s = 2.0;
+  expect_stops_at_the_pads(run_closed_loop(fs, default_options()), "the integral option alone");
+  std::printf("brake off while >= 2 kN commanded: %.0f ms; without the restart at the switch %.0f ms and %s at %.3f s\n",
               1e3 * off_s(r), 1e3 * off_s(wound), to_string(fr(wound).finding), fr(wound).detected_s);
 }
 
