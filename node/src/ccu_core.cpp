@@ -28,6 +28,8 @@ faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, fau
   // The corners' actuator test in holds (their controller's hold_test_*).
   base.test_pulse_current_A = scenario.controller.hold_test_current_A;
   base.test_pulse_s = scenario.controller.hold_test_pulse_s;
+  // The corners' speed limit (the tracking rule's drive at full speed).
+  base.drive_max_speed_rev_per_s = scenario.controller.max_speed_rev_per_s;
   const long pulse_samples = std::lround(base.test_pulse_s / scenario.plant_dt_s);
   if (base.test_pulse_current_A > 0.0 && pulse_samples > faults::TorqueDetector::kMaxPulseSamples) {
     throw std::invalid_argument("controller.hold_test_pulse_s = " + std::to_string(base.test_pulse_s) + " s is " +

@@ -624,6 +624,46 @@ TEST(FaultMonitor, ABrakeThatDoesNotReleaseIsNamedAndOneThatMovesBackIsNot) {
   EXPECT_FALSE(run(8.0, 0.0, 1.0).present);   // 2 kN over: within the 3 kN threshold
 }
 
+// A released brake told 37 kN at once (a corner back from a link silence in a hard stop, tune_b
+// seed 1403 run 752) applies at its 25 rev/s limit: 8 rev take 0.32 s, longer than the tracking
+// model's 0.1 s time constant allows, and the force stays more than 30 % of the command below the
+// model for 0.22 s. A drive at full speed towards its command (tracking.full_speed_fraction of
+// the corners' speed limit) holds the model at its force: nothing named. Without that, it is
+// actuator_tracking; and a drive that stops halfway is still named, 0.2 s after the model passes it.
+TEST(FaultMonitor, AnApplyAtTheDrivesSpeedLimitIsNotATrackingFault) {
+  auto run = [](double fraction, double stop_rev) {
+    MonitorParams p = noiseless();
+    p.drive_max_speed_rev_per_s = 25.0;
+    p.tracking_full_speed_fraction = fraction;
+    SampleCheck ok;
+    FaultMonitor m(p, Target::FL);
+    double x = 0.0, speed = 0.0;
+    const double accel = 2500.0;  // rev/s^2: 10 ms to the limit
+    for (int k = 1; k <= 1000; ++k) {
+      const double t = 0.001 * k;
+      const double target = std::min(8.0, stop_rev);
+      const double v_next = t > 0.1 ? std::min({25.0, speed + 0.001 * accel, std::sqrt(2.0 * accel * std::max(0.0, target - x))}) : 0.0;
+      const double a = (v_next - speed) / 0.001;
+      speed = v_next;
+      x += 0.001 * speed;
+      const double force_kN = 37.0 * std::pow(std::min(x, 8.0) / 8.0, 3);
+      auto r = at(k, t, x, force_kN);
+      r.speed_rev_per_s = speed;
+      r.motor_current_A = (force_kN * p.Nm_per_kN + p.inertia_kg_m2 * 2.0 * M_PI * a) / p.torque_per_A_Nm;
+      r.force_command_kN = t > 0.1 ? 37.0 : 0.0;
+      m.update(r, ok, nullptr, force_kN, t);
+    }
+    return m.diagnosis(Part::Actuator);
+  };
+  const Diagnosis healthy = run(0.8, 100.0);
+  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
+  const Diagnosis without = run(0.0, 100.0);
+  EXPECT_EQ(without.finding, Finding::ActuatorTracking);
+  const Diagnosis stopped = run(0.8, 5.0);
+  EXPECT_EQ(stopped.finding, Finding::ActuatorTracking);
+  EXPECT_LT(stopped.detected_s, 0.6);
+}
+
 // The corner's loop holds its load cell at the command, so a healthy clamp force stands off the
 // command by the key friction (stress population, 2026-11-26: a caliper with 2.7-3 kN of key
 // friction held its clamp force 3 kN above a falling command and was named not releasing). The
@@ -1115,6 +1155,52 @@ TEST(FaultMonitor, ALoadCellStepDuringOrAfterAnActuatorTestIsStillAnOffset) {
   }
   EXPECT_FALSE(run(0, -6e-4).present);  // the pulse alone
   EXPECT_FALSE(run(143, -5e-3).present);  // a square that moved the rotor 5 mrev: not a still window
+}
+
+// A drive in a hold that slips back 0.9 mrev during an actuator test, on a caliper with stiff
+// keys (thresholds 2-5 mrev, 2.5 kN half-width: every element sticks at the reversal, about 700
+// kN/rev together): the load cell follows the keys' friction down by about 0.6 kN with no fault.
+// The still rule allows the keys' whole stiffness x the window's travel
+// (step.friction_allowance) and names nothing; without it, that is a load-cell offset (stress
+// seed 1406 run 311: 0.52 kN after 1 mrev in a 12 kN hold). A -1 kN bias right after the same
+// creep is still named within 15 ms.
+TEST(FaultMonitor, TheStillRuleAllowsTheKeysFrictionForTheWindowsTravel) {
+  auto run = [](bool allowance, double bias_kN) {
+    MonitorParams p = eol_params(2.5, true);
+    p.step_friction_allowance = allowance;
+    p.test_pulse_current_A = 1.5;
+    p.test_pulse_s = 0.003;
+    EolCaliper caliper{p};
+    auto& [eol, keys, T] = caliper;
+    FaultMonitor m(p, Target::FR);
+    SampleGuard g{MonitorParams{}.guard};
+    double x = 0.0;
+    for (int n = 1; n < 1400; ++n) {
+      const double t = 0.001 * n;
+      double speed = n <= 1000 ? 4.2 : 0.004 * ((n % 3) - 1);
+      if (n <= 1000) x = 0.0042 * n;
+      const double hold_A = eol.force_kN(x, T, 0.0) * p.Nm_per_kN / p.torque_per_A_Nm;
+      double current = hold_A;
+      if (n >= 1140 && n < 1146) {  // the test: 3 ms back, 3 ms forth; 0.9 mrev back net, 0.6 of it at once
+        const int i = n - 1140;
+        current = i < 3 ? -1.5 : 2.0 * hold_A + 1.5;
+        x -= i == 2 ? 0.6e-3 : i > 2 ? 0.1e-3 : 0.0;
+        speed = i >= 2 ? -0.15 : 0.0;
+      }
+      const double lc = eol.force_kN(x, T, 0.0) + keys.step(x) + 0.03 * ((n % 5) - 2) + (n >= 1150 ? bias_kN : 0.0);
+      auto r = live_reading(n, t, x, speed, lc, p);
+      r.motor_current_A = current;
+      m.update(r, g.check(r), nullptr, r.force_kN, t);
+    }
+    return m.diagnosis(Part::LoadCell);
+  };
+  const Diagnosis healthy = run(true, 0.0);
+  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
+  const Diagnosis without = run(false, 0.0);
+  EXPECT_EQ(without.finding, Finding::LoadCellOffset);
+  const Diagnosis bias = run(true, -1.0);
+  EXPECT_EQ(bias.finding, Finding::LoadCellOffset);
+  EXPECT_LT(bias.detected_s, 1.165);
 }
 
 // Before any fit (issue 14): once the position has swept twice the largest key-friction

@@ -166,6 +166,10 @@ void MonitorParams::validate() const {
   require(tracking_relative >= 0.0 && tracking_relative < 1.0, "tracking_relative", tracking_relative,
           "must be in [0, 1)");
   positive("tracking_persist_s", tracking_persist_s);
+  require(tracking_full_speed_fraction >= 0.0 && tracking_full_speed_fraction <= 1.0, "tracking_full_speed_fraction",
+          tracking_full_speed_fraction, "must be in [0, 1]");
+  require(std::isfinite(drive_max_speed_rev_per_s) && drive_max_speed_rev_per_s >= 0.0, "drive_max_speed_rev_per_s",
+          drive_max_speed_rev_per_s, "must be >= 0");
   positive("force_limit_kN", force_limit_kN);
   positive("release_min_speed_rev_per_s", release_min_speed_rev_per_s);
   positive("deadline_s", deadline_s);
@@ -205,7 +209,7 @@ Part part_of(Finding f) {
 }
 
 FaultMonitor::FaultMonitor(const MonitorParams& params, Target corner)
-    : p_((params.validate(), params)), corner_(corner), residual_(params), torque_(params), moving_step_(params) {
+    : p_((params.validate(), params)), corner_(corner), residual_(params), torque_(params), step_(params), moving_step_(params) {
   if (!corner_slot(corner)) throw std::invalid_argument("FaultMonitor: monitors a corner, not the CCU");
 }
 

@@ -105,6 +105,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.step_kN = st.number("step_kN", pos);
   p.step_keep_fraction = st.number("keep_fraction", Range{0.0, 1.0, true, false});
   p.step_confirm_samples = static_cast<int>(st.integer("confirm_samples", 1, 1000));
+  p.step_friction_allowance = st.boolean("friction_allowance");
   {
     auto mv = st.map("moving");
     p.step_moving = mv.boolean("enabled");
@@ -189,6 +190,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.tracking_threshold_kN = k.number("threshold_kN", pos);
   p.tracking_relative = k.number("relative", Range{0.0, 1.0, false, true});
   p.tracking_persist_s = k.number("persist_s", pos);
+  p.tracking_full_speed_fraction = k.number("full_speed_fraction", config::Range::closed(0.0, 1.0));
   p.force_limit_kN = k.number("force_limit_kN", pos);
   p.release_min_speed_rev_per_s = k.number("release_min_speed_rev_per_s", pos);
   k.finish();

@@ -4,8 +4,15 @@
 #include <cmath>
 
 #include "bbw/faults/fault_monitor.hpp"
+#include "bbw/plant/key_friction.hpp"
 
 namespace bbw::faults {
+
+StepDetector::StepDetector(const MonitorParams& p) {
+  if (!p.eol_key_friction) return;
+  const plant::KeyFriction keys(*p.eol_key_friction);
+  for (const double k : keys.stiffness_kN_per_rev()) all_sticking_kN_per_rev_ += k;
+}
 
 void StepDetector::update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a) {
   const CornerReading& r = c.r;
@@ -24,10 +31,10 @@ void StepDetector::update(const SampleContext& c, const MonitorParams& p, Diagno
     }
     reset();  // returned: noise, not a bias
   }
-  double level = 0.0;
-  if (still_level(p, r.position_rev, 0, kAcrossPulseSpans, level)) {
+  double level = 0.0, step_kN = 0.0;
+  if (still_level(p, r.position_rev, 0, kAcrossPulseSpans, level, step_kN)) {
     const double d = r.force_kN - level;
-    if (std::abs(d) >= p.step_kN) {
+    if (std::abs(d) >= step_kN) {
       begin_step(level, d, r.time_s);
       return;
     }
@@ -44,7 +51,8 @@ void StepDetector::update(const SampleContext& c, const MonitorParams& p, Diagno
 // sample judged. A pulse splits it into segments, each of which must be still; across a pulse the
 // rotor may stand `across_pulse` still spans off (the pulse's own travel, 0.1-1 mrev; the clamp
 // force that moves is tens of N).
-bool StepDetector::still_level(const MonitorParams& p, double x_now, int skip, double across_pulse, double& level) const {
+bool StepDetector::still_level(const MonitorParams& p, double x_now, int skip, double across_pulse, double& level,
+                               double& step_kN) const {
   const int n = p.step_still_samples;
   if (count_ - skip < n) return false;
   double xmin = x_now, xmax = x_now, seg_min = x_now, seg_max = x_now, after = x_now, sum = 0.0;
@@ -78,6 +86,7 @@ bool StepDetector::still_level(const MonitorParams& p, double x_now, int skip, d
           xmax - xmin <= (crossed ? across_pulse : 1.0) * p.step_still_span_rev;
   if (!still || changes < p.step_min_position_changes) return false;
   level = sum / used;
+  step_kN = p.step_kN + (p.step_friction_allowance ? all_sticking_kN_per_rev_ * (xmax - xmin) : 0.0);
   return true;
 }
 
@@ -98,10 +107,10 @@ void StepDetector::on_test_pulse(int samples, double time_s, const MonitorParams
   // This sample, the first after the pulse, against the still samples before the pulse: a step
   // that came during the pulse, which its samples hid while it ran.
   const auto now = static_cast<std::size_t>((head_ - 1 + kMaxWindow) % kMaxWindow);
-  double level = 0.0;
-  if (!still_level(p, x_[now], 1, kDuringPulseSpans, level)) return;
+  double level = 0.0, step_kN = 0.0;
+  if (!still_level(p, x_[now], 1, kDuringPulseSpans, level, step_kN)) return;
   const double d = lc_[now] - level;
-  if (std::abs(d) < p.step_kN) return;
+  if (std::abs(d) < step_kN) return;
   // ... and a step, not a slide: at least half of it between two samples (a bias comes at once; a
   // creeping rotor's force and a load cell's own creep move a little each sample).
   double jump = 0.0;

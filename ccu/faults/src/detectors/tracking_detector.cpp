@@ -23,6 +23,12 @@ void TrackingDetector::update(const SampleContext& c, double force_estimate_kN, 
   } else {
     model_kN_ += (cmd - model_kN_) * -std::expm1(-c.dt_s / p.tracking_time_constant_s);
   }
+  // A drive at full speed towards its command: the response cannot be faster.
+  const double full_speed = p.tracking_full_speed_fraction * p.drive_max_speed_rev_per_s;
+  if (full_speed > 0.0 && std::abs(r.speed_rev_per_s) >= full_speed &&
+      (r.speed_rev_per_s > 0.0) == (cmd > force_estimate_kN)) {
+    model_kN_ = force_estimate_kN;
+  }
   // A shortfall counts below both the command and the model, an excess above both (a release
   // faster than the model, or an apply faster than it, is not a fault).
   const double limit = std::max(p.tracking_threshold_kN, p.tracking_relative * std::abs(cmd));

@@ -219,6 +219,13 @@ struct MonitorParams {
   double step_kN = 0.5;
   double step_keep_fraction = 0.6;
   int step_confirm_samples = 5;         // repeats that name the frozen channel of a residual
+  // The still window's level may also move by the end-of-line keys' whole stiffness (every
+  // element sticking) x the window's travel, with the sample judged: a drive standing within a
+  // few still spans (across a test pulse) still turns its key friction by that much. Without it a
+  // healthy caliper with stiff keys (the stress population's) crept back 1 mrev after a pulse
+  // in a 12 kN hold, its load cell fell 0.52 kN with the friction, and the still rule named it a
+  // load-cell offset (stress seed 1406 run 311). Off: step_kN alone.
+  bool step_friction_allowance = true;
   // Moving (MovingStepDetector, with an end-of-line curve and key-friction model, beyond its
   // contact point): the load cell against the end-of-line curve leaves the straight line through
   // its last step_moving_window_samples values by step_kN + 4x their spread about it + the key
@@ -436,6 +443,14 @@ struct MonitorParams {
   double tracking_threshold_kN = 3.0;
   double tracking_relative = 0.3;             // of the command
   double tracking_persist_s = 0.2;
+  // A drive running towards its command at tracking_full_speed_fraction of its speed limit
+  // (drive_max_speed_rev_per_s, the corners' controller.max_speed_rev_per_s) does all it can:
+  // the model is held at the force estimate then (a command response cannot outrun the drive).
+  // Without it a corner that re-applied a 37 kN hard stop from its released safe state after a
+  // 0.72 s link silence, 0.28 s at the 25 rev/s limit, was named actuator_tracking (tune_b seed
+  // 1403 run 752). 0: off.
+  double tracking_full_speed_fraction = 0.8;
+  double drive_max_speed_rev_per_s = 0.0;     // 0: unknown (the rule above off)
   double force_limit_kN = 40.0;               // commands above it are not expected to be reached
   // An excess is a brake that does not release only while it does not move back at least this
   // fast (a brake that releases, if slowly, e.g. back-driven after a torque loss, moves).

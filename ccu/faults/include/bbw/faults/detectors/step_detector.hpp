@@ -17,6 +17,9 @@ namespace bbw::faults {
 class StepDetector {
  public:
   static constexpr int kMaxWindow = 64;
+  // Takes the end-of-line keys' whole stiffness (MonitorParams::step_friction_allowance; 0
+  // without an end-of-line key model).
+  explicit StepDetector(const MonitorParams& p);
   void update(const SampleContext& c, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() { reset(); }
   bool pending() const { return pending_; }
@@ -39,11 +42,14 @@ class StepDetector {
     count_ = 0;
     pending_ = false;
   }
-  bool still_level(const MonitorParams& p, double x_now, int skip, double across_pulse, double& level) const;
+  // The still window's mean load cell, and the step it must be left by (step_kN and the keys'
+  // allowance for the window's travel).
+  bool still_level(const MonitorParams& p, double x_now, int skip, double across_pulse, double& level, double& step_kN) const;
   void begin_step(double level_kN, double step_kN, double time_s);
   std::array<double, kMaxWindow> x_{};
   std::array<double, kMaxWindow> lc_{};
   std::array<bool, kMaxWindow> pulse_{};  // the sample belonged to a test pulse
+  double all_sticking_kN_per_rev_ = 0.0;  // the end-of-line keys' whole stiffness
   int head_ = 0;   // next slot
   int count_ = 0;  // samples in the window
   bool pending_ = false;
