@@ -53,9 +53,10 @@ struct ControllerParams {
   // reaction moves the loop from the load cell to the curve or back), the force loop restarts its
   // stiffness estimate and its force integral: the step between the two sources is no travel of
   // the caliper, and neither the slope nor the integral of the old source's error fits the new
-  // one. Without it the step (6 kN at 6.36 rev, no motion) read as a 1200 kN/rev caliper; the
-  // loop, its gain cut 80-fold, released at 0.2 rev/s and wound its integral, which then drove
-  // the release from the hard stop 0.6 rev behind the pads' contact (tune_bias run 94).
+  // one. Without it the step (6.3 kN at 6.36 rev, after 1.2 mrev of travel) read as a 1200
+  // kN/rev caliper; the loop, its gain cut 80-fold, backed off at 0.2-0.8 rev/s and wound its
+  // integral, which then drove the release from the hard stop 0.66 rev behind the pads' contact
+  // (tune_bias run 94). A step while releasing needs nothing: the release restarts both anyway.
   bool feedback_switch_restart = true;
   // Curve feedback (the CCU's calibrated cubic): below this position, or below the cubic's local
   // minimum if that is higher, the estimate is the end-of-line curve scaled to meet the cubic
