@@ -108,8 +108,8 @@ const CornerSample& CornerSim::step(double dt_s, const ExternalInputs& ext) {
                     : mode_ == DriveMode::Position ? corner_unit::ForceFeedback::LoadCell
                                                    : feedback_;
     in.force_feedback_kN = corner_unit::select_force(fb, src);
-    const int source = static_cast<int>(fb == corner_unit::ForceFeedback::Curve && !ext.curve ? corner_unit::ForceFeedback::LoadCell : fb);
-    in.feedback_switched = last_feedback_source_ >= 0 && source != last_feedback_source_;
+    const auto source = fb == corner_unit::ForceFeedback::Curve && !ext.curve ? corner_unit::ForceFeedback::LoadCell : fb;
+    in.feedback_switched = last_feedback_source_ && source != *last_feedback_source_;
     last_feedback_source_ = source;
     out = controller_.update_force(cmd, in, dt_s, rate);
     sample_.command_kind = CommandKind::Force;

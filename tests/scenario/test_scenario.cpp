@@ -9,6 +9,8 @@
 #include <string>
 #include <tuple>
 
+#include <Eigen/Dense>
+
 #include "bbw/plant/clamp_curve.hpp"
 #include "bbw/plant/params_yaml.hpp"
 #include "bbw/scenario/corner_sim.hpp"
@@ -445,28 +447,15 @@ TEST(CornerSim, AFeedbackSwitchRestartsTheForceLoopsStiffnessAndIntegral) {
   const double temperature_C = s.corners[0].conditions.temperature_C;
   // The cubic through 1.13 x the end-of-line curve at four positions from 1 rev to past the hold.
   const double contact_rev = eol.contact_rev(temperature_C, 0.0);
-  double m[4][5];
+  Eigen::Matrix4d v;
+  Eigen::Vector4d f;
   for (int i = 0; i < 4; ++i) {
     const double x = contact_rev + 1.0 + 2.0 * i;
-    m[i][0] = x * x * x;
-    m[i][1] = x * x;
-    m[i][2] = x;
-    m[i][3] = 1.0;
-    m[i][4] = 1.13 * eol.force_kN(x, temperature_C, 0.0);
+    v.row(i) << x * x * x, x * x, x, 1.0;
+    f(i) = 1.13 * eol.force_kN(x, temperature_C, 0.0);
   }
-  for (int k = 0; k < 4; ++k) {
-    for (int i = k + 1; i < 4; ++i) {
-      const double f = m[i][k] / m[k][k];
-      for (int j = k; j < 5; ++j) m[i][j] -= f * m[k][j];
-    }
-  }
-  double coef[4];
-  for (int k = 3; k >= 0; --k) {
-    double v = m[k][4];
-    for (int j = k + 1; j < 4; ++j) v -= m[k][j] * coef[j];
-    coef[k] = v / m[k][k];
-  }
-  const scenario::CurveEstimate high{coef[0], coef[1], coef[2], coef[3]};
+  const Eigen::Vector4d coef = v.colPivHouseholderQr().solve(f);
+  const scenario::CurveEstimate high{coef(0), coef(1), coef(2), coef(3)};
   struct Biased : scenario::SensorHook {
     void apply(plant::Measurement& m) override { m.force_internal_kN -= 1.5; }
   };

@@ -131,8 +131,8 @@ class CornerSim {
   double held_speed_rev_per_s_ = 0.0;
   double held_load_cell_kN_ = 0.0;
   // The source the force loop read last step (curve feedback without a curve is the load cell);
-  // -1 before the first force-mode step.
-  int last_feedback_source_ = -1;
+  // none before the first force-mode step.
+  std::optional<corner_unit::ForceFeedback> last_feedback_source_;
   double held_temperature_C_ = 0.0;
   CornerSample sample_;
 };
