@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <random>
 
@@ -1953,4 +1954,52 @@ TEST(FaultMonitor, AHeldDriveWithoutCurrentCannotRaiseItsLoadCell) {
   MonitorParams off = shipped;
   off.unpowered_hold = false;
   EXPECT_FALSE(run(0.0, 0.0, 1.0, off).present);
+}
+
+// A resolver that freezes while the loop accelerates its drive (frozen at 0.39 rev/s, 19 A for
+// 25 ms more until the corner cuts the current) leaves a rotor that coasts on unseen: at 20 kN the
+// bound (19 A x 0.27 Nm/A less 0.8 Nm of load, over 2 pi 3e-3 kg m^2: 5.7 rev/s; the load and the
+// drive's friction stop it in about 0.13 s) keeps the unpowered-hold rule off while the clamp
+// force rises 0.6 kN; a +1 kN load-cell step after the coast is still named. Without the bound the
+// coast's rise is a load-cell offset (issue 14, twenty-fourth session, tuning seed 1401 run 341).
+TEST(FaultMonitor, AnUnpoweredHoldAllowsTheCoastOfARotorThatWasAcceleratingWhenTheResolverFroze) {
+  const MonitorParams shipped;
+  const SampleCheck ok;
+  // 100 live samples at 20 kN, then the resolver frozen at 0.39 rev/s with 19 A for 25 samples
+  // and 0 A after; the clamp force rises 0.6 kN over 100 ms from the cut; `step_kN` at 450 ms.
+  auto run = [&](double step_kN, const MonitorParams& p, double* bound_at_cut) {
+    FaultMonitor m(p, Target::RL);
+    std::uint64_t seq = 0;
+    double t = 0.0;
+    for (int k = 0; k < 100; ++k) {
+      t += 0.001;
+      auto r = at(++seq, t, 4.0 + 2e-5 * (k % 3), 20.0 + 0.01 * (k % 2));
+      r.speed_rev_per_s = 1e-3 * (k % 5);
+      r.motor_current_A = 3.0;
+      m.update(r, ok, nullptr, r.force_kN, t);
+    }
+    for (int k = 0; k < 600; ++k) {
+      t += 0.001;
+      const double coast_kN = 0.6 * std::clamp((k - 25) / 100.0, 0.0, 1.0);
+      auto r = at(++seq, t, 4.0, 20.0 + 0.01 * (k % 2) + coast_kN + (k >= 450 ? step_kN : 0.0));
+      r.speed_rev_per_s = 0.39;
+      r.motor_current_A = k < 25 ? 19.0 : 0.0;
+      m.update(r, ok, nullptr, r.force_kN, t);
+      if (k == 25 && bound_at_cut != nullptr) *bound_at_cut = m.unpowered_forward_speed_bound_rev_per_s();
+    }
+    EXPECT_EQ(m.diagnosis(Part::Resolver).finding, Finding::ResolverStuck);
+    return m.diagnosis(Part::LoadCell);
+  };
+  double bound = 0.0;
+  EXPECT_FALSE(run(0.0, shipped, &bound).present);
+  EXPECT_NEAR(bound, 0.39 + 25 * 0.001 * (19.0 * 0.27 - 0.0398 * 19.0) / (2 * std::numbers::pi * 3e-3), 0.5);
+  const auto step = run(1.0, shipped, nullptr);
+  EXPECT_TRUE(step.present);
+  EXPECT_EQ(step.finding, Finding::LoadCellOffset);
+  EXPECT_GE(step.onset_s, 0.1 + 0.45 - 1e-6);  // the step's, not the coast's
+  MonitorParams off = shipped;
+  off.unpowered_coast_bound = false;
+  const auto coast = run(0.0, off, nullptr);
+  EXPECT_TRUE(coast.present);
+  EXPECT_EQ(coast.finding, Finding::LoadCellOffset);
 }

@@ -123,6 +123,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.unpowered_max_current_A = up.number("max_current_A", pos);
   p.unpowered_settle_samples = static_cast<int>(up.integer("settle_samples", 2, UnpoweredHoldDetector::kMaxWindow));
   p.unpowered_max_speed_rev_per_s = up.number("max_speed_rev_per_s", pos);
+  p.unpowered_coast_bound = up.boolean("coast_bound");
   p.unpowered_min_load_margin_kN = up.number("min_load_margin_kN", config::Range::non_negative());
   p.unpowered_kN = up.number("kN", pos);
   up.finish();

@@ -254,6 +254,11 @@ struct MonitorParams {
   bool unpowered_hold = true;
   double unpowered_max_current_A = 0.5;
   double unpowered_max_speed_rev_per_s = 0.5;
+  // The speed held to unpowered_max_speed_rev_per_s is also a bound on the unseen spindle's forward
+  // speed since the resolver froze: what the measured current can make less what the load and the
+  // drive's friction take, over the reflected inertia (a rotor accelerating when the resolver froze
+  // coasts on after its current is cut; UnpoweredHoldDetector).
+  bool unpowered_coast_bound = true;
   int unpowered_settle_samples = 20;
   double unpowered_min_load_margin_kN = 0.5;
   double unpowered_kN = 0.5;
@@ -523,6 +528,9 @@ class FaultMonitor {
   // A residual disagreement is under way but not yet confirmed: the calibrator must not learn
   // from these samples (CornerSupervisor holds its fits).
   bool residual_suspect() const { return residual_.suspect(); }
+  // The unpowered-hold rule's bound on the spindle's forward speed (rev/s; the measured speed while
+  // the resolver lives, what the current could add since it froze).
+  double unpowered_forward_speed_bound_rev_per_s() const { return unpowered_.forward_speed_bound_rev_per_s(); }
   // Share of large residual steps in the noise window.
   double last_noise_fraction() const { return noise_.fraction(); }
   Target corner() const { return corner_; }
