@@ -61,6 +61,14 @@ faults::MonitorParams corner_monitor_params(const scenario::Scenario& scenario, 
   // follows the spindle, not the motor).
   const auto& backlash = corner.effects.backlash;
   corner_mp.eol_backlash_rev = backlash.enabled ? backlash.width_rev : 0.0;
+  // Its pads' creep likewise (relaxation fraction and time constant; 0: none).
+  const auto& creep = corner.effects.creep;
+  corner_mp.eol_creep_fraction = creep.enabled ? creep.relaxation_fraction : 0.0;
+  corner_mp.eol_creep_time_constant_s = creep.time_constant_s;
+  // And its keys' friction growth with the clamp force (gain 0: none).
+  const auto& load_friction = corner.effects.load_dependent_friction;
+  corner_mp.eol_friction_load_gain = load_friction.enabled ? load_friction.gain : 0.0;
+  corner_mp.eol_friction_reference_kN = load_friction.reference_force_kN;
   return corner_mp;
 }
 

@@ -103,7 +103,11 @@ void Plant::substep(double i_cmd_A, double torque_scale, bool seized, double h_s
     s_.creep_kN *= std::exp(-h_s / e_.creep.time_constant_s);
   }
   s_.curve_force_kN = fc;
-  s_.force_true_kN = fc + s_.creep_kN;
+  // The pads push, never pull: a fast release that leaves the creep's excess below the relaxed
+  // curve (negative) takes the pads off the disc at no clamp force, not at a negative one (a
+  // release from a 17 kN hold to 0 read -0.73 kN of true clamp force before the twenty-fourth
+  // session).
+  s_.force_true_kN = std::max(0.0, fc + s_.creep_kN);
   s_.wear_rev += c_.wear_rate_rev_per_kN_s * std::max(s_.force_true_kN, 0.0) * h_s;
 }
 

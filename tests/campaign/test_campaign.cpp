@@ -49,6 +49,7 @@ duration_s: [12, 14]
 population: {spec: POP, members: 5}
 temperatures_C: [28, 54]
 effects_share: 0.3
+effects: [viscous_friction, sensor_delay, backlash]
 profiles: [city, hard_stop_release]
 faults:
   kinds: [bias, seized]
@@ -78,16 +79,45 @@ TEST(CampaignSpec, BadInputNamesLineKeyAndRule) {
   fails(s + "extra: 1\n", "extra");
   s = good();
   s.replace(s.find("[city, hard_stop_release]"), 25, "[city, bogus]");
-  fails(s, "t.yaml:9: key 'profiles'");
+  fails(s, "t.yaml:10: key 'profiles'");
   s = good();
   s.replace(s.find("[12, 14]"), 8, "[14, 12]");
   fails(s, "min must be <= max");
   s = good();
   s.replace(s.find("[bias, seized]"), 14, "[bias, bias]");
   fails(s, "listed twice");
+  s = good();
+  s.replace(s.find("[viscous_friction, sensor_delay, backlash]"), 42, "[creep, wear]");
+  fails(s, "entry 1 'wear' must be one of viscous_friction, sensor_delay, backlash, load_dependent_friction, creep, thermal_drift");
+  s = good();
+  s.replace(s.find("[viscous_friction, sensor_delay, backlash]"), 42, "[]");
+  fails(s, "key 'effects'");
 }
 
 CampaignSpec spec() { return load_campaign_spec_string(good(), "t.yaml"); }
+
+// The plant effects a campaign draws from are its spec's (`effects`); each loads as the corner's.
+TEST(CampaignDraw, TheEffectsDrawnAreTheSpecsOwn) {
+  CampaignSpec s = spec();
+  s.effects = {"creep", "load_dependent_friction", "thermal_drift"};
+  s.effects_share = 1.0;
+  s.runs = 20;
+  const std::string plant = src("config/plant/ecaliper.yaml");
+  std::set<std::string> seen;
+  for (int i = 0; i < 20; ++i) {
+    const RunPlan r = draw_run(s, i);
+    const auto fs = faults::load_fault_scenario_string(scenario_yaml(s, r, plant), "run.yaml");
+    for (std::size_t c = 0; c < 4; ++c) {
+      seen.insert(r.effect[c]);
+      const auto& e = fs.scenario.corners.at(c).effects;
+      EXPECT_EQ(e.creep.enabled, r.effect[c] == "creep");
+      EXPECT_EQ(e.load_dependent_friction.enabled, r.effect[c] == "load_dependent_friction");
+      EXPECT_EQ(e.thermal_drift.enabled, r.effect[c] == "thermal_drift");
+      EXPECT_FALSE(e.viscous_friction.enabled || e.sensor_delay.enabled || e.backlash.enabled);
+    }
+  }
+  EXPECT_EQ(seen, (std::set<std::string>{"creep", "load_dependent_friction", "thermal_drift"}));
+}
 
 TEST(CampaignDraw, ARunDependsOnItsIndexAndTheSeedOnly) {
   CampaignSpec a = spec();

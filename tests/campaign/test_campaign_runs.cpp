@@ -36,7 +36,7 @@ std::string small_spec(const std::string& dir, int runs) {
   std::ofstream(file) << "name: small\nseed: 77\nruns: " << runs
                       << "\nfault_free_share: 0.34\nduration_s: [12, 12]\npopulation: {spec: "
                       << src("config/population/scoring.yaml")
-                      << ", members: 30}\ntemperatures_C: [28, 54]\neffects_share: 0.3\n"
+                      << ", members: 30}\ntemperatures_C: [28, 54]\neffects_share: 0.3\neffects: [viscous_friction, sensor_delay, backlash]\n"
                          "profiles: [city, hard_stop_release]\nfaults:\n  kinds: [bias, total_loss, dropout]\n"
                          "  onsets: [normal]\n  two_faults_share: 0\n  same_corner_share: 0\n  intermittent_share: 0\n";
   return file;

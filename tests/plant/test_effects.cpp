@@ -252,3 +252,27 @@ TEST(Effects, CreepRelaxesTheForceUnderHeldPositionWithTheTimeConstant) {
   for (const auto& r : on) peak = std::max(peak, r.force_external_kN);
   EXPECT_NEAR((peak - f_inf) / peak, 0.1, 0.025);
 }
+
+// Creep's excess turns negative in a fast release (the relaxed curve falls faster than the pads
+// recover): released to the home position the pads leave the disc at no clamp force, not at a
+// negative one (before the twenty-fourth session -0.7 kN after a release from a 17 kN hold).
+TEST(Effects, CreepNeverPullsThePadsBelowNoClampForce) {
+  scenario::PositionProfileSpec hold;
+  hold.start_rev = 0.0;
+  scenario::Steps step;
+  step.levels_rev = {4.5, 0.0};
+  step.hold_s = 3.0;
+  hold.segments.push_back(step);
+  plant::EffectsParams e;
+  e.creep.enabled = true;
+  e.creep.relaxation_fraction = 0.1;
+  e.creep.time_constant_s = 1.0;
+  const Rec on = with(e, hold, 40.0, 6.0);
+  double lowest = 1e9, highest = 0.0;
+  for (const auto& r : on) {
+    lowest = std::min(lowest, r.force_true_kN);
+    highest = std::max(highest, r.force_true_kN);
+  }
+  EXPECT_GT(highest, 20.0);  // the hold happened
+  EXPECT_GE(lowest, 0.0);
+}

@@ -47,6 +47,12 @@ void MonitorParams::validate() const {
   positive("modulation_time_constant_s", modulation_time_constant_s);
   positive("modulation_min_spread_rev_per_s", modulation_min_spread_rev_per_s);
   require(std::isfinite(eol_backlash_rev) && eol_backlash_rev >= 0.0, "eol_backlash_rev", eol_backlash_rev, "must be >= 0");
+  require(std::isfinite(eol_creep_fraction) && eol_creep_fraction >= 0.0 && eol_creep_fraction < 1.0, "eol_creep_fraction",
+          eol_creep_fraction, "must be in [0, 1)");
+  positive("eol_creep_time_constant_s", eol_creep_time_constant_s);
+  require(std::isfinite(eol_friction_load_gain) && eol_friction_load_gain >= 0.0, "eol_friction_load_gain",
+          eol_friction_load_gain, "must be >= 0");
+  positive("eol_friction_reference_kN", eol_friction_reference_kN);
   require(std::isfinite(eol_friction_model_share) && eol_friction_model_share >= 0.0 && eol_friction_model_share <= 1.0,
           "eol_friction_model_share", eol_friction_model_share, "must be in [0, 1]");
   require(std::isfinite(eol_friction_amplitude_factor) && eol_friction_amplitude_factor >= 1.0,

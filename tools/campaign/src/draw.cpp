@@ -265,10 +265,11 @@ RunPlan draw_run(const CampaignSpec& spec, int index) {
   r.fault_free = std::floor((index + 1) * spec.fault_free_share + 1e-9) > std::floor(index * spec.fault_free_share + 1e-9);
   r.duration_s = std::round(rng.uniform(spec.duration_min_s, spec.duration_max_s));
   r.member = rng.integer(0, spec.population_members - 1);
-  constexpr const char* kEffects[] = {"viscous_friction", "sensor_delay", "backlash"};
   for (std::size_t c = 0; c < 4; ++c) {
     r.temperature_C[c] = std::round(rng.uniform(spec.temperature_min_C, spec.temperature_max_C) * 10.0) / 10.0;
-    if (rng.chance(spec.effects_share)) r.effect[c] = kEffects[rng.integer(0, 2)];
+    if (rng.chance(spec.effects_share)) {
+      r.effect[c] = spec.effects[static_cast<std::size_t>(rng.integer(0, static_cast<int>(spec.effects.size()) - 1))];
+    }
   }
   const Onset first_onset = rng.pick(spec.onsets);
   r.profile = r.fault_free ? rng.pick(spec.profiles) : profile_for(spec, first_onset, rng);

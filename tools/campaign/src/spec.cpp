@@ -1,6 +1,8 @@
 #include "spec.hpp"
 
+#include <algorithm>
 #include <filesystem>
+#include <string_view>
 
 #include "bbw/common/strict_yaml.hpp"
 
@@ -15,6 +17,9 @@ constexpr FaultKind kKinds[] = {FaultKind::Bias,          FaultKind::Drift,     
                                 FaultKind::ResolverStuck, FaultKind::TorqueLoss, FaultKind::TotalLoss,
                                 FaultKind::Seized,        FaultKind::Silence,    FaultKind::Delay};
 constexpr Onset kOnsets[] = {Onset::BeforeFirstFit, Onset::HardStop, Onset::Normal};
+// The plant's optional effects (plant::EffectsParams), as a scenario's corner names them.
+constexpr std::string_view kEffects[] = {"viscous_friction", "sensor_delay",  "backlash",
+                                         "load_dependent_friction", "creep", "thermal_drift"};
 
 template <class E, std::size_t N>
 std::vector<E> names_list(config::Reader& r, const std::string& key, const E (&all)[N]) {
@@ -63,6 +68,18 @@ CampaignSpec read(config::Reader& r) {
   }
   std::tie(s.temperature_min_C, s.temperature_max_C) = interval(r, "temperatures_C", config::Range::closed(-40.0, 140.0));
   s.effects_share = r.number("effects_share", config::Range::closed(0.0, 1.0));
+  s.effects = r.strings("effects");
+  if (s.effects.empty()) r.fail("effects", "must list at least one plant effect");
+  for (std::size_t i = 0; i < s.effects.size(); ++i) {
+    if (std::find(std::begin(kEffects), std::end(kEffects), s.effects[i]) == std::end(kEffects)) {
+      std::string list;
+      for (std::string_view e : kEffects) list += (list.empty() ? "" : ", ") + std::string(e);
+      r.fail("effects", "entry " + std::to_string(i) + " '" + s.effects[i] + "' must be one of " + list);
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (s.effects[j] == s.effects[i]) r.fail("effects", "'" + s.effects[i] + "' is listed twice");
+    }
+  }
   s.profiles = names_list(r, "profiles", kProfiles);
   {
     config::Reader f = r.map("faults");

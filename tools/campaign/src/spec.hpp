@@ -36,7 +36,8 @@ struct CampaignSpec {
   int population_line = 0;               // where `population` is in `file` (bbw_campaign checks the
                                          // members against the population's count there)
   double temperature_min_C = 28.0, temperature_max_C = 54.0;
-  double effects_share = 0.3;            // of the corners: one plant effect switched on
+  double effects_share = 0.3;            // of the corners: one plant effect switched on,
+  std::vector<std::string> effects;      //   drawn from these (plant::EffectsParams' names)
   std::vector<Profile> profiles;
   // Faults of a faulty run.
   std::vector<FaultKind> fault_kinds;

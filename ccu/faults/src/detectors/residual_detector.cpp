@@ -42,8 +42,32 @@ ResidualDetector::ResidualDetector(const MonitorParams& p)
   }
 }
 
+double ResidualDetector::scaled_half_width_kN(const MonitorParams& p) const {
+  return p.eol_friction_half_width_kN * friction_scale_;
+}
+
+void ResidualDetector::step_creep(double x_rev, const CornerReading& r, const MonitorParams& p) {
+  if (!eol_ || !p.eol_creep_model || p.eol_creep_fraction <= 0.0) return;
+  const double temperature_C = std::isfinite(r.temperature_C) ? r.temperature_C : eol_->params().reference_temperature_C;
+  const double curve_kN = eol_->force_kN(x_rev, temperature_C, 0.0);
+  if (have_creep_ && r.time_s > creep_time_s_) {
+    const double dt_s = r.time_s - creep_time_s_;
+    // The plant's standard linear solid: a change of the relaxed curve force adds f / (1 - f) of
+    // itself, which relaxes with the time constant. Across a gap (the position unseen) only the
+    // relaxation is known.
+    if (dt_s <= p.jump_max_gap_s) creep_kN_ += p.eol_creep_fraction / (1.0 - p.eol_creep_fraction) * (curve_kN - creep_curve_kN_);
+    creep_kN_ *= std::exp(-dt_s / p.eol_creep_time_constant_s);
+  }
+  have_creep_ = true;
+  creep_curve_kN_ = curve_kN;
+  creep_time_s_ = r.time_s;
+}
+
 void ResidualDetector::track_position(const CornerReading& r, const MonitorParams& p) {
-  if (!eol_friction_) return;
+  if (!eol_friction_) {
+    step_creep(r.position_rev, r, p);
+    return;
+  }
   // Every element's state is known once the position has risen (or fallen) by twice its
   // threshold from a low (high) point: from there it slips, whatever it was before.
   // On a caliper with backlash the keys move with the spindle, which the motor's resolver
@@ -61,6 +85,7 @@ void ResidualDetector::track_position(const CornerReading& r, const MonitorParam
   x_max_rev_ = std::max(x_max_rev_, r.position_rev);
   const double sweep_rev = sweep_rev_ + p.eol_backlash_rev;
   if (r.position_rev - x_min_rev_ >= sweep_rev || x_max_rev_ - r.position_rev >= sweep_rev) friction_known_ = true;
+  step_creep(spindle_rev_, r, p);
 }
 
 int ResidualDetector::judge_revisit(const CornerReading& r, double eol_keys_kN, bool& over, const MonitorParams& p) {
@@ -72,7 +97,7 @@ int ResidualDetector::judge_revisit(const CornerReading& r, double eol_keys_kN, 
   // its fits change from cycle to cycle; this does not). Before that state is known the residual
   // holds the key friction's whole width wherever it happens to be: no level to come back to.
   if (revisit_bins_.empty() || !eol_ || !friction_known_ || !std::isfinite(r.force_kN)) return -1;
-  revisit_kN_ = r.force_kN - eol_keys_kN - eol_friction_kN_;
+  revisit_kN_ = r.force_kN - eol_keys_kN - scaled_friction_kN();
   const int i = static_cast<int>(std::floor((r.position_rev - p.curve_min_rev) / p.revisit_bin_rev));
   if (i < 0 || i >= revisit_per_class_) return -1;
   // The motion (up, down, slower than a hold either way) and the keys' state: slipping all one
@@ -80,14 +105,14 @@ int ResidualDetector::judge_revisit(const CornerReading& r, double eol_keys_kN, 
   // the model's error depends on where the reversal was, not only on the position.
   constexpr double kSlippingFraction = 0.98;
   const int direction = r.speed_rev_per_s > p.hold_speed_rev_per_s ? 0 : r.speed_rev_per_s < -p.hold_speed_rev_per_s ? 1 : 2;
-  const bool between = std::abs(eol_friction_kN_) < kSlippingFraction * eol_friction_half_width_kN_;
+  const bool between = std::abs(scaled_friction_kN()) < kSlippingFraction * eol_friction_half_width_kN_;
   const int motion = 2 * direction + (between ? 1 : 0);
   const int bin = motion * revisit_per_class_ + i;
   const RevisitBin& b = revisit_bins_[static_cast<std::size_t>(bin)];
   if (b.n >= p.revisit_settle_samples) {
     revisit_change_kN_ = revisit_kN_ - b.level_kN;
     // Between, the model knows the keys' friction within its share of the width.
-    const double friction_kN = between ? p.eol_friction_model_share * p.eol_friction_half_width_kN : 0.0;
+    const double friction_kN = between ? p.eol_friction_model_share * scaled_half_width_kN(p) : 0.0;
     revisit_threshold_kN_ =
         eol_allowance_kN(p, p.revisit_kN, friction_kN, 0.0, r.speed_rev_per_s - b.speed_rev_per_s);
     over = std::abs(revisit_change_kN_) > revisit_threshold_kN_;
@@ -189,7 +214,19 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   const double temperature_C =
       eol_ && std::isfinite(r.temperature_C) ? r.temperature_C : eol_ ? eol_->params().reference_temperature_C : 0.0;
   const double x_keys_rev = friction_known_ ? spindle_rev_ : r.position_rev;
-  const double eol_keys_kN = eol_ ? eol_->force_kN(x_keys_rev, temperature_C, 0.0) : e.curve_force_kN;
+  // The pads' creep (their relaxation after the curve force changed, as the end-of-line test
+  // measured it; 0 without) is part of the clamp force wherever the curve is.
+  const double creep_kN = eol_ ? creep_kN_ : 0.0;
+  // measured it; 0 without) is part of the clamp force wherever the curve is; the pads push, never
+  // pull (the plant's clamp force is at least 0).
+  auto pads_kN = [&](double x_rev) { return std::max(0.0, eol_->force_kN(x_rev, temperature_C, 0.0) + creep_kN); };
+  const double eol_keys_kN = eol_ ? pads_kN(x_keys_rev) : e.curve_force_kN;
+  // Keys whose friction grows with the clamp force (as the end-of-line test measured it: the
+  // plant's load-dependent friction, key friction x (1 + gain F / F_ref)): the friction model and
+  // every band of its width scale with the force where the keys are.
+  friction_scale_ = eol_ && p.eol_friction_load_model && p.eol_friction_load_gain > 0.0
+                        ? 1.0 + p.eol_friction_load_gain * std::max(0.0, eol_keys_kN) / p.eol_friction_reference_kN
+                        : 1.0;
   // The raw load cell against the curve at the position (the estimate is filtered: it hid noise
   // bursts of 0.35 kN RMS in held hard stops, issue 14); with an end-of-line curve, against it
   // and the end-of-line friction model once its state is known (beyond the fitted range the
@@ -197,7 +234,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // by 0.1-0.3 kN per sample and raised load_cell_noisy on two healthy corners, tuning run 367).
   // Below the trusted range (released, no clamp load) the key friction snaps back and forth with
   // small motions by up to its full width within milliseconds: that is not sensor noise.
-  const double curve_kN = eol_keys_kN + (eol_ && friction_known_ ? eol_friction_kN_ : 0.0);
+  const double curve_kN = eol_keys_kN + (eol_ && friction_known_ ? scaled_friction_kN() : 0.0);
   const double noise_kN = std::isfinite(r.force_kN) ? r.force_kN - curve_kN : residual_kN_;
   // Below it (released), the load cell's own second differences (MonitorParams::noise_released),
   // once their level is learnt.
@@ -227,20 +264,20 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   bool low_over = false;
   const bool below = eol_ && !above_min && p.residual_findings && std::isfinite(r.force_kN);
   if (below && p.residual_low_upper_bound) {
-    const double f_hi_kN = std::max(0.0, eol_->force_kN(r.position_rev + 0.5 * p.eol_backlash_rev, temperature_C, 0.0));
-    low_over = r.force_kN - f_hi_kN > eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_half_width_kN, f_hi_kN, r.speed_rev_per_s);
+    const double f_hi_kN = std::max(0.0, pads_kN(r.position_rev + 0.5 * p.eol_backlash_rev));
+    low_over = r.force_kN - f_hi_kN > eol_allowance_kN(p, p.eol_band_kN, scaled_half_width_kN(p), f_hi_kN, r.speed_rev_per_s);
   }
   // From below: the clamp force is never negative, and the keys pull the reading below it by at
   // most their half-width, wherever the pads are (a negative drift on a released or fallen-back
   // caliper, tuning seed 1403 run 124: -1.6 kN at no clamp force, never named).
   if (below && p.residual_low_lower_bound) {
     low_over = low_over ||
-               -r.force_kN > eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_half_width_kN, 0.0, r.speed_rev_per_s);
+               -r.force_kN > eol_allowance_kN(p, p.eol_band_kN, scaled_half_width_kN(p), 0.0, r.speed_rev_per_s);
   }
   if (below && p.residual_low_static_span_rev > 0.0) {
     // The curve at the motor's position: the keys' position is the motor's until the friction
     // model's state is known.
-    const double motor_eol_kN = friction_known_ ? eol_->force_kN(r.position_rev, temperature_C, 0.0) : eol_keys_kN;
+    const double motor_eol_kN = friction_known_ ? pads_kN(r.position_rev) : eol_keys_kN;
     low_over = static_changed(r, motor_eol_kN, p) || low_over;
   } else {
     static_ref_ = false;
@@ -273,9 +310,9 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     residual_kN_ = r.force_kN - eol_kN;
     // The key friction: its end-of-line model once its state is known (within a share of its
     // width: identification error, a drive's backlash), else anywhere within its width.
-    double friction_band_kN = p.eol_friction_half_width_kN;
+    double friction_band_kN = scaled_half_width_kN(p);
     if (friction_known_) {
-      residual_kN_ -= eol_friction_kN_;
+      residual_kN_ -= scaled_friction_kN();
       friction_band_kN *= p.eol_friction_model_share;
     }
     thr = eol_allowance_kN(p, p.eol_band_kN, friction_band_kN, eol_kN, r.speed_rev_per_s);
@@ -290,11 +327,12 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     if (eol_) {
       // The calibrator's friction, within what the caliper's key friction can hold (a fit that
       // explains more than the end-of-line width as friction is wrong, not the load cell).
-      const double hw = p.eol_friction_half_width_kN;
+      const double hw = scaled_half_width_kN(p);
       const double friction_kN = std::clamp(e.friction_kN, -hw, hw);
       // At the motor's position, as the calibrator fitted its friction (the spindle's, with a
       // backlash corner's play, mixed the two and raised 6 fault-free findings on backlash corners).
-      const double eol_motor_kN = x_keys_rev == r.position_rev ? eol_keys_kN : eol_->force_kN(r.position_rev, temperature_C, 0.0);
+      const double eol_motor_kN =
+          x_keys_rev == r.position_rev ? eol_keys_kN : pads_kN(r.position_rev);
       const double load_cell_kN = e.force_kN + e.friction_kN;  // the calibrator's filtered load cell
       residual_kN_ = load_cell_kN - friction_kN - eol_motor_kN;
       if (friction_known_ && p.calibrated_two_friction_models) {
@@ -305,7 +343,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
         // they bracket it: at a reversal the calibrator's elements, fitted on their own
         // thresholds, lag a friction that flips within 0.02 rev (fault-free findings on a
         // backlash corner of a non-ideal caliper, tuning seed 1403 run 601).
-        const double eol_model_kN = load_cell_kN - eol_keys_kN - eol_friction_kN_;
+        const double eol_model_kN = load_cell_kN - eol_keys_kN - scaled_friction_kN();
         const double lo = std::min(residual_kN_, eol_model_kN), hi = std::max(residual_kN_, eol_model_kN);
         residual_kN_ = std::clamp(0.0, lo, hi);
       }
@@ -313,7 +351,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     if (!std::isfinite(ms_residual_kN2_)) {
       // The first fit's friction model may be poor: start from the end-of-line band (or, without
       // an end-of-line curve, from the fixed thresholds) and learn the corner's own from there.
-      const double start_kN = eol_ ? p.eol_friction_half_width_kN + p.eol_band_kN : p.residual_threshold_kN;
+      const double start_kN = eol_ ? scaled_half_width_kN(p) + p.eol_band_kN : p.residual_threshold_kN;
       ms_residual_kN2_ = std::pow(start_kN / p.residual_sigma_factor, 2);
       ms_change_kN2_ = std::pow(std::max(p.residual_change_threshold_kN, eol_ ? start_kN : 0.0) / p.residual_sigma_factor, 2);
       stats_time_s_ = t;
@@ -330,10 +368,10 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       // The residual nearest zero of the two friction models is never farther from zero than the
       // end-of-line one: this cap makes the calibrated rule no less sensitive than the
       // end-of-line band it replaced, however far the learnt statistics have grown.
-      const double eol_thr = eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_model_share * p.eol_friction_half_width_kN,
+      const double eol_thr = eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_model_share * scaled_half_width_kN(p),
                                               eol_keys_kN, r.speed_rev_per_s);
       thr = std::max(p.residual_threshold_kN, std::min(thr, eol_thr));
-      const double eol_thr0 = eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_model_share * p.eol_friction_half_width_kN,
+      const double eol_thr0 = eol_allowance_kN(p, p.eol_band_kN, p.eol_friction_model_share * scaled_half_width_kN(p),
                                                eol_keys_kN, 0.0);
       thr0 = std::max(p.residual_threshold_kN, std::min(thr0, eol_thr0));
     }
@@ -427,7 +465,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       hold_r0_kN_ = hold_sum_kN_ / hold_slow_;
       hold_x0_rev_ = x_hold;
       hold_f0_kN_ = hold_curve_kN;
-      hold_friction0_kN_ = eol_friction_kN_;
+      hold_friction0_kN_ = scaled_friction_kN();
       hold_friction_ref_ = friction_known_;
     }
   } else if (hold_ref_) {
@@ -436,10 +474,10 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     // model's share of it; with hold.friction_as_moved, the share of what the model's friction
     // moved since the hold settled (at most the width): keys that went on slipping the same way
     // (a drive creeping on into the load) kept their friction, in the model and on the caliper.
-    double friction_kN = (friction_known_ ? p.eol_friction_model_share : 1.0) * p.eol_friction_half_width_kN;
+    double friction_kN = (friction_known_ ? p.eol_friction_model_share : 1.0) * scaled_half_width_kN(p);
     if (friction_known_ && hold_friction_ref_ && p.hold_friction_as_moved) {
-      const double moved_kN = std::abs(eol_friction_kN_ - hold_friction0_kN_);
-      friction_kN = p.eol_friction_model_share * std::min(p.eol_friction_half_width_kN, moved_kN);
+      const double moved_kN = std::abs(scaled_friction_kN() - hold_friction0_kN_);
+      friction_kN = p.eol_friction_model_share * std::min(scaled_half_width_kN(p), moved_kN);
     }
     const double hold_thr = eol_allowance_kN(p, p.hold_kN, friction_kN, hold_curve_kN - hold_f0_kN_, r.speed_rev_per_s);
     hold_threshold_kN_ = hold_thr;

@@ -97,6 +97,21 @@ struct MonitorParams {
   // The caliper's backlash between the motor (the resolver) and the spindle (the keys, the
   // pads), as its end-of-line test measured it (CcuCore sets the corner's; 0: none).
   double eol_backlash_rev = 0.0;
+  // The pads' creep (a standard linear solid: a change of the relaxed curve force adds
+  // f / (1 - f) of itself, which relaxes with the time constant), as the caliper's end-of-line
+  // test measured it (CcuCore sets the corner's; fraction 0: none). With eol_creep_model every
+  // end-of-line curve force the residual rules use includes it (without, a caliper with creep
+  // raised load_cell_offset in 23 of 30 fault-free runs: its hold relaxes by the fraction).
+  bool eol_creep_model = true;
+  // Keys whose friction grows with the clamp force (the plant's load-dependent friction: key
+  // friction x (1 + gain F / reference)), as the end-of-line test measured it (CcuCore sets the
+  // corner's; gain 0: none): with eol_friction_load_model the residual rules' friction model and
+  // its bands scale with the force.
+  bool eol_friction_load_model = true;
+  double eol_friction_load_gain = 0.0;
+  double eol_friction_reference_kN = 40.0;
+  double eol_creep_fraction = 0.0;
+  double eol_creep_time_constant_s = 1.0;
   // Hold rule: slower than hold_speed_rev_per_s for hold_settle_samples sets the residual's
   // reference level (their mean); while the position stays within hold_span_rev of it, a change
   // beyond hold_kN + eol_relative x the curve's change + the friction's uncertainty (end of line:

@@ -194,6 +194,15 @@ class ResidualDetector {
   double hold_last_kN_ = std::numeric_limits<double>::quiet_NaN();
   double hold_last_x_rev_ = 0.0;
   double hold_last_curve_kN_ = 0.0;
+  // The key friction's growth with the clamp force (MonitorParams::eol_friction_load_gain), this
+  // sample's: the end-of-line friction model's force and its half-width times it.
+  double friction_scale_ = 1.0;
+  double scaled_friction_kN() const { return eol_friction_kN_ * friction_scale_; }
+  double scaled_half_width_kN(const MonitorParams& p) const;
+  // The pads' creep model (MonitorParams::eol_creep_fraction), stepped with the position.
+  void step_creep(double x_rev, const CornerReading& r, const MonitorParams& p);
+  bool have_creep_ = false;
+  double creep_kN_ = 0.0, creep_curve_kN_ = 0.0, creep_time_s_ = 0.0;
   // The revisit rule (MonitorParams::revisit): per position bin and class (moving up, down or
   // slow; the keys all slipping one way or between), the healthy residual's level and the speed
   // it was learnt at. Sized at construction.
