@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <numbers>
@@ -1204,6 +1205,44 @@ TEST(FaultMonitor, TheStillRuleAllowsTheKeysFrictionForTheWindowsTravel) {
   EXPECT_LT(bias.detected_s, 1.165);
 }
 
+// A drive stopped within a sample (a seizure at 20 rev/s) stands within the still span from that
+// sample on, while that sample's load cell still carries the speed's viscous term (0.2 kN/(rev/s):
+// 4 kN). The still rule leaves out windows with a sample measured at speed
+// (step.still_max_speed_rev_per_s); without that it took the 4 kN fall for a load-cell step
+// (issue 14, twenty-fourth session, effects campaign run 132). A -1 kN bias 0.2 s into the stop is
+// still named at once.
+TEST(FaultMonitor, TheStillRuleLeavesOutASampleTakenAtSpeed) {
+  auto run = [](double max_speed_rev_per_s, double bias_kN) {
+    MonitorParams p = eol_params(1.5, false);
+    p.step_still_max_speed_rev_per_s = max_speed_rev_per_s;
+    EolCaliper caliper{p};
+    auto& [eol, keys, T] = caliper;
+    FaultMonitor m(p, Target::RR);
+    SampleGuard g{MonitorParams{}.guard};
+    double x = 0.0;
+    for (int n = 1; n < 600; ++n) {
+      const double t = 0.001 * n;
+      const bool moving = n <= 250;  // sample 250 reads the stop's position with the speed before it
+      if (n < 250) x = 0.02 * n;
+      const double speed = moving ? 20.0 : 0.004 * ((n % 3) - 1);
+      const double lc = eol.force_kN(x, T, 0.0) + keys.step(x) + (moving ? 0.2 * 20.0 : 0.0) + 0.03 * ((n % 5) - 2) +
+                        (n >= 450 ? bias_kN : 0.0);
+      const auto r = live_reading(n, t, x, speed, lc, p);
+      m.update(r, g.check(r), nullptr, r.force_kN, t);
+    }
+    return m.diagnosis(Part::LoadCell);
+  };
+  const Diagnosis healthy = run(1.0, 0.0);
+  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
+  const Diagnosis without = run(0.0, 0.0);
+  EXPECT_EQ(without.finding, Finding::LoadCellOffset);
+  EXPECT_LT(without.detected_s, 0.3);
+  const Diagnosis bias = run(1.0, -1.0);
+  EXPECT_EQ(bias.finding, Finding::LoadCellOffset);
+  EXPECT_GE(bias.onset_s, 0.45 - 1e-9);
+  EXPECT_LT(bias.detected_s, 0.46);
+}
+
 // Before any fit (issue 14): once the position has swept twice the largest key-friction
 // threshold, the end-of-line friction model's state is known, its friction is subtracted and the
 // band narrows from the whole half-width to its model share; and while the actuator holds, the
@@ -1993,6 +2032,7 @@ TEST(FaultMonitor, AnUnpoweredHoldAllowsTheCoastOfARotorThatWasAcceleratingWhenT
   double bound = 0.0;
   EXPECT_FALSE(run(0.0, shipped, &bound).present);
   EXPECT_NEAR(bound, 0.39 + 25 * 0.001 * (19.0 * 0.27 - 0.0398 * 19.0) / (2 * std::numbers::pi * 3e-3), 0.5);
+  std::printf("the forward speed bound at the cut: %.2f rev/s\n", bound);
   const auto step = run(1.0, shipped, nullptr);
   EXPECT_TRUE(step.present);
   EXPECT_EQ(step.finding, Finding::LoadCellOffset);

@@ -68,7 +68,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(hold_calibrated); SAME(hold_rebase); SAME(hold_friction_as_moved);
   SAME(revisit); SAME(revisit_kN); SAME(revisit_bin_rev); SAME(revisit_settle_samples); SAME(revisit_forget_s); SAME(modulation); SAME(modulation_time_constant_s); SAME(modulation_min_spread_rev_per_s);
   SAME(stuck_frozen_samples); SAME(stuck_frozen_run_factor); SAME(stuck_resolver_clear_samples);
-  SAME(step_still_samples); SAME(step_still_span_rev); SAME(step_min_position_changes); SAME(step_kN); SAME(step_keep_fraction);
+  SAME(step_still_samples); SAME(step_still_span_rev); SAME(step_still_max_speed_rev_per_s); SAME(step_min_position_changes); SAME(step_kN); SAME(step_keep_fraction);
   SAME(unpowered_hold); SAME(unpowered_max_current_A); SAME(unpowered_settle_samples); SAME(unpowered_max_speed_rev_per_s); SAME(unpowered_coast_bound); SAME(unpowered_min_load_margin_kN); SAME(unpowered_kN);
   SAME(step_confirm_samples); SAME(step_moving); SAME(step_moving_resolver_stuck_pads_off); SAME(step_moving_window_samples); SAME(step_moving_quiet_fraction);
   SAME(step_moving_unexplained_rev); SAME(step_moving_speed_kN_per_rev_per_s);

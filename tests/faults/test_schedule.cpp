@@ -54,7 +54,8 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
       continue;
     }
     ++files;
-    if (fs.scenario.name == "fault_free_stop") {
+    if (fs.scenario.name == "fault_free_stop" || fs.scenario.name == "fault_free_pad_creep_hard_stops" ||
+        fs.scenario.name == "fault_free_load_dependent_friction_hard_stops") {
       EXPECT_TRUE(fs.faults.empty());
     } else if (fs.scenario.name == "load_cell_drift_then_a_resolver_offset" ||
                fs.scenario.name == "load_cell_drift_then_a_total_loss_released" ||
@@ -75,7 +76,8 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
       types.insert(fs.faults.faults[0].type);
     }
   }
-  EXPECT_EQ(files, 39u);  // actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four
+  EXPECT_EQ(files, 43u);  // calipers with pad creep and with load-dependent friction: fault-free, and with a
+                          // load-cell bias in a hard stop; actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four
                           // times: in a hold, while applying, before the first fit, in a hard stop released on the
                           // curve; load_cell drift four times: in a stop, followed by the loop in a hard stop,
                           // while the brake modulates, below the trusted range; load_cell dropout twice: in a

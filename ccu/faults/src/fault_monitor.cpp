@@ -74,6 +74,8 @@ void MonitorParams::validate() const {
   require(step_still_samples >= 2 && step_still_samples <= StepDetector::kMaxWindow, "step_still_samples",
           step_still_samples, "must be in [2, 64]");
   positive("step_still_span_rev", step_still_span_rev);
+  require(std::isfinite(step_still_max_speed_rev_per_s) && step_still_max_speed_rev_per_s >= 0.0,
+          "step_still_max_speed_rev_per_s", step_still_max_speed_rev_per_s, "must be >= 0");
   require(step_min_position_changes >= 1 && step_min_position_changes <= step_still_samples,
           "step_min_position_changes", step_min_position_changes, "must be in [1, step_still_samples]");
   positive("step_kN", step_kN);

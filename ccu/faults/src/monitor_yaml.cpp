@@ -103,6 +103,7 @@ MonitorParams read_monitor_params(Reader& r) {
   auto st = r.map("step");
   p.step_still_samples = static_cast<int>(st.integer("still_samples", 2, StepDetector::kMaxWindow));
   p.step_still_span_rev = st.number("still_span_rev", pos);
+  p.step_still_max_speed_rev_per_s = st.number("still_max_speed_rev_per_s", config::Range::non_negative());
   p.step_min_position_changes = static_cast<int>(st.integer("min_position_changes", 1, StepDetector::kMaxWindow));
   p.step_kN = st.number("step_kN", pos);
   p.step_keep_fraction = st.number("keep_fraction", Range{0.0, 1.0, true, false});

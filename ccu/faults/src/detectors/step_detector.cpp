@@ -32,7 +32,7 @@ void StepDetector::update(const SampleContext& c, const MonitorParams& p, Diagno
     reset();  // returned: noise, not a bias
   }
   double level = 0.0, step_kN = 0.0;
-  if (still_level(p, r.position_rev, 0, kAcrossPulseSpans, level, step_kN)) {
+  if (!fast(p, r.speed_rev_per_s) && still_level(p, r.position_rev, 0, kAcrossPulseSpans, level, step_kN)) {
     const double d = r.force_kN - level;
     if (std::abs(d) >= step_kN) {
       begin_step(level, d, r.time_s);
@@ -41,6 +41,7 @@ void StepDetector::update(const SampleContext& c, const MonitorParams& p, Diagno
   }
   x_[static_cast<std::size_t>(head_)] = r.position_rev;
   lc_[static_cast<std::size_t>(head_)] = r.force_kN;
+  fast_[static_cast<std::size_t>(head_)] = fast(p, r.speed_rev_per_s);
   pulse_[static_cast<std::size_t>(head_)] = false;
   head_ = (head_ + 1) % kMaxWindow;
   count_ = std::min(count_ + 1, kMaxWindow);
@@ -65,6 +66,7 @@ bool StepDetector::still_level(const MonitorParams& p, double x_now, int skip, d
       split = true;
       continue;
     }
+    if (fast_[i]) return false;  // not still, whatever the position says
     const double x = x_[i];
     if (split) {  // the first still sample before a pulse: a new segment
       still = still && seg_max - seg_min <= p.step_still_span_rev;
@@ -90,6 +92,10 @@ bool StepDetector::still_level(const MonitorParams& p, double x_now, int skip, d
   return true;
 }
 
+bool StepDetector::fast(const MonitorParams& p, double speed_rev_per_s) {
+  return p.step_still_max_speed_rev_per_s > 0.0 && std::abs(speed_rev_per_s) > p.step_still_max_speed_rev_per_s;
+}
+
 void StepDetector::begin_step(double level_kN, double step_kN, double time_s) {
   pending_ = true;
   level_kN_ = level_kN;
@@ -108,7 +114,7 @@ void StepDetector::on_test_pulse(int samples, double time_s, const MonitorParams
   // that came during the pulse, which its samples hid while it ran.
   const auto now = static_cast<std::size_t>((head_ - 1 + kMaxWindow) % kMaxWindow);
   double level = 0.0, step_kN = 0.0;
-  if (!still_level(p, x_[now], 1, kDuringPulseSpans, level, step_kN)) return;
+  if (fast_[now] || !still_level(p, x_[now], 1, kDuringPulseSpans, level, step_kN)) return;
   const double d = lc_[now] - level;
   if (std::abs(d) < step_kN) return;
   // ... and a step, not a slide: at least half of it between two samples (a bias comes at once; a

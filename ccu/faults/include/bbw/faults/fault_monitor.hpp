@@ -230,6 +230,10 @@ struct MonitorParams {
   // step_keep_fraction of it for step_confirm_samples more: LoadCellOffset.
   int step_still_samples = 10;
   double step_still_span_rev = 5e-4;
+  // ... and every sample's measured speed within this (0: not judged): a drive stopped within a
+  // sample stands still from it on while the sample's load cell still carries its speed's viscous
+  // term (effects campaign run 132: a seizure at 25 rev/s on a viscous caliper, 5 kN).
+  double step_still_max_speed_rev_per_s = 1.0;
   int step_min_position_changes = 3;          // in the window and the sample: a frozen resolver is not a still actuator
   double step_kN = 0.5;
   double step_keep_fraction = 0.6;

@@ -49,6 +49,11 @@ class StepDetector {
   std::array<double, kMaxWindow> x_{};
   std::array<double, kMaxWindow> lc_{};
   std::array<bool, kMaxWindow> pulse_{};  // the sample belonged to a test pulse
+  // The sample's measured speed was beyond step_still_max_speed_rev_per_s: a drive stopped within
+  // a sample (a seizure at 25 rev/s) stands within the still span from that sample on, while its
+  // load cell still carries the speed's viscous term there (5 kN at 0.2 kN/(rev/s)).
+  std::array<bool, kMaxWindow> fast_{};
+  static bool fast(const MonitorParams& p, double speed_rev_per_s);
   double all_sticking_kN_per_rev_ = 0.0;  // the end-of-line keys' whole stiffness
   int head_ = 0;   // next slot
   int count_ = 0;  // samples in the window
