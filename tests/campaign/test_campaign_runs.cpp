@@ -82,6 +82,10 @@ TEST(CampaignSystem, CiSubsetOverDdsIsNoWorseThanMeasured) {
   const int fa_free = c["false_alarms"]["in_fault_free_runs"].as<int>();
   const int fa_faulty = c["false_alarms"]["in_faulty_runs"].as<int>();
   EXPECT_GE(detected, kMinDetected) << slurp(dir + "/c/campaign.json");
+  // Every fault counted once per plant effect of its corner ("none" without one).
+  int by_effect = 0;
+  for (const auto& e : c["by_effect"]) by_effect += e.second["faults"].as<int>();
+  EXPECT_EQ(by_effect, c["overall"]["faults"].as<int>());
   EXPECT_LE(fa_free, kMaxFalseAlarmsFaultFree) << slurp(dir + "/c/campaign.json");
   EXPECT_LE(fa_faulty, kMaxFalseAlarmsFaulty) << slurp(dir + "/c/campaign.json");
   std::cout << "CI subset: " << detected << " of " << n << " faults detected (goal: all), false alarms " << fa_free
@@ -123,6 +127,10 @@ TEST(CampaignSystem, AFaultFreeCampaignReportsItsFalseAlarmRateAndNoCoverage) {
   EXPECT_EQ(c["overall"]["faults"].as<int>(), 0);
   EXPECT_EQ(c["false_alarms"]["fault_free_runs"].as<int>(), 2);
   EXPECT_GT(c["false_alarms"]["per_hour_upper95"].as<double>(), 0.0);  // 0 seen is not a 0 rate
+  // Per plant effect of the corner: every corner's fault-free hours are counted once.
+  double corner_hours = 0.0;
+  for (const auto& e : c["false_alarms_by_effect"]) corner_hours += e.second["fault_free_corner_hours"].as<double>();
+  EXPECT_NEAR(corner_hours, 4.0 * c["false_alarms"]["fault_free_hours"].as<double>(), 1e-6);
   EXPECT_NE(slurp(dir + "/c/report.html").find("No fault was injected"), std::string::npos);
 }
 

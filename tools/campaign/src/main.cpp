@@ -327,7 +327,18 @@ int cmd_report(const std::string& dir) {
     if (fs::exists(f)) results.push_back(load_result(f));
     else ++missing;
   }
-  std::map<std::string, Group> by_kind, by_onset;
+  std::map<std::string, Group> by_kind, by_onset, by_effect;
+  // Per plant effect (the corner's, "none" without one; the draw gives each run's again): its
+  // false alarms and the corner-hours of fault-free driving it had.
+  std::map<std::string, long long> alarms_by_effect;
+  std::map<std::string, double> ff_corner_hours_by_effect;
+  auto effect_of = [](const RunPlan& plan, const std::string& corner) -> std::string {
+    constexpr const char* kCorners[] = {"FL", "FR", "RL", "RR"};
+    for (std::size_t c = 0; c < 4; ++c) {
+      if (corner == kCorners[c]) return plan.effect[c].empty() ? "none" : plan.effect[c];
+    }
+    return "none";
+  };
   Group all, bias_1kN, loss_stuck, below_limit, masked;
   long long failed = 0, ff_runs = 0, ff_alarms = 0, faulty_run_alarms = 0, runs_with_alarms = 0;
   double ff_hours = 0.0, faulty_hours = 0.0, wall_s = 0.0;
@@ -347,6 +358,11 @@ int cmd_report(const std::string& dir) {
       faulty_run_alarms += static_cast<long long>(r.false_alarms.size());
     }
     runs_with_alarms += r.false_alarms.empty() ? 0 : 1;
+    const RunPlan plan = draw_run(spec, r.index);
+    if (r.fault_free) {
+      for (const std::string& e : plan.effect) ff_corner_hours_by_effect[e.empty() ? "none" : e] += r.duration_s / 3600.0;
+    }
+    for (const auto& a : r.false_alarms) ++alarms_by_effect[effect_of(plan, a.corner)];
     for (const auto& a : r.false_alarms) {
       char buf[200];
       std::snprintf(buf, sizeof buf, "run %d (%s%s): %s %s at %.3f s", r.index, r.profile.c_str(), r.fault_free ? ", fault-free" : "",
@@ -365,6 +381,7 @@ int cmd_report(const std::string& dir) {
       add(all, r, f);
       add(by_kind[f.kind], r, f);
       add(by_onset[f.onset], r, f);
+      add(by_effect[effect_of(plan, f.corner)], r, f);
       if (f.kind == "bias" && std::abs(f.magnitude) >= 1.0) add(bias_1kN, r, f);
       if (f.kind == "total_loss" || f.kind == "seized" || f.kind == "load_cell_stuck" || f.kind == "resolver_stuck" ||
           f.kind == "dropout" || f.kind == "silence") {
@@ -382,6 +399,21 @@ int cmd_report(const std::string& dir) {
   j.end_object();
   j.begin_object("by_onset");
   for (const auto& [k, g] : by_onset) group_json(j, k, g);
+  j.end_object();
+  j.begin_object("by_effect");  // the faulted corner's plant effect
+  for (const auto& [k, g] : by_effect) group_json(j, k, g);
+  j.end_object();
+  j.begin_object("false_alarms_by_effect");  // the alarmed corner's plant effect
+  {
+    std::set<std::string> effects;
+    for (const auto& [k, n] : alarms_by_effect) effects.insert(k);
+    for (const auto& [k, h] : ff_corner_hours_by_effect) effects.insert(k);
+    for (const std::string& k : effects) {
+      j.begin_object(k).value("false_alarms", alarms_by_effect.count(k) ? alarms_by_effect.at(k) : 0LL)
+          .value("fault_free_corner_hours", ff_corner_hours_by_effect.count(k) ? ff_corner_hours_by_effect.at(k) : 0.0)
+          .end_object();
+    }
+  }
   j.end_object();
   group_json(j, "bias_at_least_1kN", bias_1kN);
   group_json(j, "loss_and_stuck", loss_stuck);
@@ -470,11 +502,22 @@ int cmd_report(const std::string& dir) {
   row("bias >= 1 kN", bias_1kN);
   row("loss and stuck", loss_stuck);
   for (const auto& [k, g] : by_onset) row("onset " + k, g);
+  for (const auto& [k, g] : by_effect) row("plant effect " + k, g);
   h << "</table><h2>False alarms</h2><p>" << ff_alarms << " in " << fmt(ff_hours, 2) << " h of fault-free driving: " << fmt(rate, 2)
     << " per hour (95 % upper bound " << fmt(upper, 2) << " per hour); " << faulty_run_alarms
     << " unexplained findings in runs with faults.</p><ul>";
   for (std::size_t i = 0; i < std::min<std::size_t>(alarm_list.size(), 100); ++i) h << "<li>" << alarm_list[i] << "</li>";
-  h << "</ul><h2>Misses</h2><ul>";
+  h << "</ul><table><tr><th>plant effect of the corner</th><th>false alarms (all runs)</th><th>fault-free corner-hours</th></tr>";
+  {
+    std::set<std::string> effects;
+    for (const auto& [k, n] : alarms_by_effect) effects.insert(k);
+    for (const auto& [k, hours] : ff_corner_hours_by_effect) effects.insert(k);
+    for (const std::string& k : effects) {
+      h << "<tr><td>" << k << "</td><td>" << (alarms_by_effect.count(k) ? alarms_by_effect.at(k) : 0LL) << "</td><td>"
+        << fmt(ff_corner_hours_by_effect.count(k) ? ff_corner_hours_by_effect.at(k) : 0.0, 2) << "</td></tr>";
+    }
+  }
+  h << "</table><h2>Misses</h2><ul>";
   for (const auto& m : all.misses) h << "<li>" << m << "</li>";
   h << "</ul><h2>Masked faults</h2><p>" << masked.n
     << " injected faults could not show themselves before they ended (an actuator fault while its corner's resolver was"
