@@ -69,6 +69,10 @@ faults::MonitorParams corner_monitor_params(const scenario::Scenario& scenario, 
   const auto& load_friction = corner.effects.load_dependent_friction;
   corner_mp.eol_friction_load_gain = load_friction.enabled ? load_friction.gain : 0.0;
   corner_mp.eol_friction_reference_kN = load_friction.reference_force_kN;
+  // And its load cell's offset with temperature (0: none).
+  const auto& thermal = corner.effects.thermal_drift;
+  corner_mp.eol_load_cell_kN_per_C = thermal.enabled ? thermal.offset_kN_per_C : 0.0;
+  corner_mp.eol_load_cell_reference_C = thermal.reference_temperature_C;
   return corner_mp;
 }
 

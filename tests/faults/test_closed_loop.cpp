@@ -774,6 +774,16 @@ TEST(ClosedLoopIssue14, KeysWhoseFrictionGrowsWithTheForceRaiseNothingAndABiasIs
                             "load-dependent friction model", [](MonitorParams& m) { m.eol_friction_load_model = false; });
 }
 
+// A load cell whose offset moves with temperature (the plant's thermal drift, 0.9-1.0 kN at
+// 86-90 C) on every corner: released, the readings sat an offset above the end-of-line curve.
+// Expecting the offset the end-of-line test measured (residual.end_of_line.thermal_offset_model)
+// nothing is raised, and a -1 kN bias is still named.
+TEST(ClosedLoopIssue14, ALoadCellThatDriftsWithTemperatureRaisesNothingAndABiasIsStillNamed) {
+  expect_effect_model_holds("config/scenarios/faults/fault_free_thermal_drift_hot_hard_stops.yaml",
+                            "config/scenarios/faults/load_cell_bias_in_a_hard_stop_with_thermal_drift.yaml",
+                            "thermal offset model", [](MonitorParams& m) { m.eol_thermal_offset_model = false; });
+}
+
 // A total loss while a hard stop applies at the speed limit: the motor brakes with -40 A and the
 // rotor coasts on (tuning seed 1403 run 158). Named lost by the braking rule in its window; never
 // without it.

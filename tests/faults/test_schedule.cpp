@@ -55,7 +55,8 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
     }
     ++files;
     if (fs.scenario.name == "fault_free_stop" || fs.scenario.name == "fault_free_pad_creep_hard_stops" ||
-        fs.scenario.name == "fault_free_load_dependent_friction_hard_stops") {
+        fs.scenario.name == "fault_free_load_dependent_friction_hard_stops" ||
+        fs.scenario.name == "fault_free_thermal_drift_hot_hard_stops") {
       EXPECT_TRUE(fs.faults.empty());
     } else if (fs.scenario.name == "load_cell_drift_then_a_resolver_offset" ||
                fs.scenario.name == "load_cell_drift_then_a_total_loss_released" ||
@@ -76,7 +77,7 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
       types.insert(fs.faults.faults[0].type);
     }
   }
-  EXPECT_EQ(files, 43u);  // calipers with pad creep and with load-dependent friction: fault-free, and with a
+  EXPECT_EQ(files, 45u);  // calipers with pad creep, load-dependent friction, a hot load cell's thermal drift: fault-free, and with a
                           // load-cell bias in a hard stop; actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four
                           // times: in a hold, while applying, before the first fit, in a hard stop released on the
                           // curve; load_cell drift four times: in a stop, followed by the loop in a hard stop,

@@ -53,6 +53,8 @@ void MonitorParams::validate() const {
   require(std::isfinite(eol_friction_load_gain) && eol_friction_load_gain >= 0.0, "eol_friction_load_gain",
           eol_friction_load_gain, "must be >= 0");
   positive("eol_friction_reference_kN", eol_friction_reference_kN);
+  require(std::isfinite(eol_load_cell_kN_per_C), "eol_load_cell_kN_per_C", eol_load_cell_kN_per_C, "must be finite");
+  require(std::isfinite(eol_load_cell_reference_C), "eol_load_cell_reference_C", eol_load_cell_reference_C, "must be finite");
   require(std::isfinite(eol_friction_model_share) && eol_friction_model_share >= 0.0 && eol_friction_model_share <= 1.0,
           "eol_friction_model_share", eol_friction_model_share, "must be in [0, 1]");
   require(std::isfinite(eol_friction_amplitude_factor) && eol_friction_amplitude_factor >= 1.0,

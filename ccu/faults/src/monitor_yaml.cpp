@@ -42,6 +42,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.eol_friction_model_share = eol.number("friction_model_share", config::Range::closed(0.0, 1.0));
     p.eol_creep_model = eol.boolean("creep_model");
     p.eol_friction_load_model = eol.boolean("friction_load_model");
+    p.eol_thermal_offset_model = eol.boolean("thermal_offset_model");
     p.calibrated_two_friction_models = eol.boolean("calibrated_two_friction_models");
     p.calibrated_capped_by_eol = eol.boolean("calibrated_capped");
     eol.finish();

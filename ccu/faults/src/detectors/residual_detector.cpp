@@ -215,17 +215,21 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       eol_ && std::isfinite(r.temperature_C) ? r.temperature_C : eol_ ? eol_->params().reference_temperature_C : 0.0;
   const double x_keys_rev = friction_known_ ? spindle_rev_ : r.position_rev;
   // The pads' creep (their relaxation after the curve force changed, as the end-of-line test
-  // measured it; 0 without) is part of the clamp force wherever the curve is.
-  const double creep_kN = eol_ ? creep_kN_ : 0.0;
   // measured it; 0 without) is part of the clamp force wherever the curve is; the pads push, never
-  // pull (the plant's clamp force is at least 0).
-  auto pads_kN = [&](double x_rev) { return std::max(0.0, eol_->force_kN(x_rev, temperature_C, 0.0) + creep_kN); };
+  // pull (the plant's clamp force is at least 0). The load cell's offset with temperature (as the
+  // end-of-line test measured it; 0 without) is part of what it reads there.
+  const double creep_kN = eol_ ? creep_kN_ : 0.0;
+  const double lc_offset_kN = eol_ && p.eol_thermal_offset_model
+                                  ? p.eol_load_cell_kN_per_C * (temperature_C - p.eol_load_cell_reference_C)
+                                  : 0.0;
+  auto clamp_kN = [&](double x_rev) { return std::max(0.0, eol_->force_kN(x_rev, temperature_C, 0.0) + creep_kN); };
+  auto pads_kN = [&](double x_rev) { return clamp_kN(x_rev) + lc_offset_kN; };
   const double eol_keys_kN = eol_ ? pads_kN(x_keys_rev) : e.curve_force_kN;
   // Keys whose friction grows with the clamp force (as the end-of-line test measured it: the
   // plant's load-dependent friction, key friction x (1 + gain F / F_ref)): the friction model and
   // every band of its width scale with the force where the keys are.
   friction_scale_ = eol_ && p.eol_friction_load_model && p.eol_friction_load_gain > 0.0
-                        ? 1.0 + p.eol_friction_load_gain * std::max(0.0, eol_keys_kN) / p.eol_friction_reference_kN
+                        ? 1.0 + p.eol_friction_load_gain * clamp_kN(x_keys_rev) / p.eol_friction_reference_kN
                         : 1.0;
   // The raw load cell against the curve at the position (the estimate is filtered: it hid noise
   // bursts of 0.35 kN RMS in held hard stops, issue 14); with an end-of-line curve, against it
@@ -272,7 +276,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // caliper, tuning seed 1403 run 124: -1.6 kN at no clamp force, never named).
   if (below && p.residual_low_lower_bound) {
     low_over = low_over ||
-               -r.force_kN > eol_allowance_kN(p, p.eol_band_kN, scaled_half_width_kN(p), 0.0, r.speed_rev_per_s);
+               lc_offset_kN - r.force_kN > eol_allowance_kN(p, p.eol_band_kN, scaled_half_width_kN(p), 0.0, r.speed_rev_per_s);
   }
   if (below && p.residual_low_static_span_rev > 0.0) {
     // The curve at the motor's position: the keys' position is the motor's until the friction

@@ -108,6 +108,12 @@ struct MonitorParams {
   // corner's; gain 0: none): with eol_friction_load_model the residual rules' friction model and
   // its bands scale with the force.
   bool eol_friction_load_model = true;
+  // A load cell whose offset moves with temperature (the plant's thermal drift: k (T - T_ref)), as
+  // the end-of-line test measured it (CcuCore sets the corner's; 0: none): with
+  // eol_thermal_offset_model the residual rules expect it in the load cell's reading.
+  bool eol_thermal_offset_model = true;
+  double eol_load_cell_kN_per_C = 0.0;
+  double eol_load_cell_reference_C = 40.0;
   double eol_friction_load_gain = 0.0;
   double eol_friction_reference_kN = 40.0;
   double eol_creep_fraction = 0.0;
