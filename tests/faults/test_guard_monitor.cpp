@@ -1952,6 +1952,23 @@ TEST(FaultMonitor, TheTorqueRulesStartAgainAfterLostSamples) {
   EXPECT_EQ(run(named_at - 3, 0.28), -1);
 }
 
+namespace {
+
+// 100 samples of a drive holding 20 kN at 4 rev with a live resolver (its reading moves by its
+// noise) and 3 A: the unpowered-hold tests' start, before the resolver freezes.
+void hold_live_at_20kN(FaultMonitor& m, std::uint64_t& seq, double& t) {
+  const SampleCheck ok;
+  for (int k = 0; k < 100; ++k) {
+    t += 0.001;
+    auto r = at(++seq, t, 4.0 + 2e-5 * (k % 3), 20.0 + 0.01 * (k % 2));
+    r.speed_rev_per_s = 1e-3 * (k % 5);
+    r.motor_current_A = 3.0;
+    m.update(r, ok, nullptr, r.force_kN, t);
+  }
+}
+
+}  // namespace
+
 // A resolver that freezes while its drive holds 20 kN leaves the motor without current: the
 // clamp force can stay or fall (the load drives the spindle back), never rise. So a load cell
 // that rises by more than unpowered_kN from the level it settled at names a load-cell offset
@@ -1966,13 +1983,7 @@ TEST(FaultMonitor, AHeldDriveWithoutCurrentCannotRaiseItsLoadCell) {
     FaultMonitor m(p, Target::RL);
     std::uint64_t seq = 0;
     double t = 0.0;
-    for (int k = 0; k < 100; ++k) {
-      t += 0.001;
-      auto r = at(++seq, t, 4.0 + 2e-5 * (k % 3), 20.0 + 0.01 * (k % 2));
-      r.speed_rev_per_s = 1e-3 * (k % 5);
-      r.motor_current_A = 3.0;
-      m.update(r, ok, nullptr, r.force_kN, t);
-    }
+    hold_live_at_20kN(m, seq, t);
     for (int k = 0; k < 400; ++k) {
       t += 0.001;
       const double moved = change_kN * std::clamp((k - 100) / 50.0, 0.0, 1.0);
@@ -1997,7 +2008,7 @@ TEST(FaultMonitor, AHeldDriveWithoutCurrentCannotRaiseItsLoadCell) {
 
 // A resolver that freezes while the loop accelerates its drive (frozen at 0.39 rev/s, 19 A for
 // 25 ms more until the corner cuts the current) leaves a rotor that coasts on unseen: at 20 kN the
-// bound (19 A x 0.27 Nm/A less 0.8 Nm of load, over 2 pi 3e-3 kg m^2: 5.7 rev/s; the load and the
+// bound (19 A x 0.27 Nm/A less 0.8 Nm of load, over 2 pi 3e-3 kg m^2, and the drive's friction: 5.84 rev/s at the cut; the load and the
 // drive's friction stop it in about 0.13 s) keeps the unpowered-hold rule off while the clamp
 // force rises 0.6 kN; a +1 kN load-cell step after the coast is still named. Without the bound the
 // coast's rise is a load-cell offset (issue 14, twenty-fourth session, tuning seed 1401 run 341).
@@ -2010,13 +2021,7 @@ TEST(FaultMonitor, AnUnpoweredHoldAllowsTheCoastOfARotorThatWasAcceleratingWhenT
     FaultMonitor m(p, Target::RL);
     std::uint64_t seq = 0;
     double t = 0.0;
-    for (int k = 0; k < 100; ++k) {
-      t += 0.001;
-      auto r = at(++seq, t, 4.0 + 2e-5 * (k % 3), 20.0 + 0.01 * (k % 2));
-      r.speed_rev_per_s = 1e-3 * (k % 5);
-      r.motor_current_A = 3.0;
-      m.update(r, ok, nullptr, r.force_kN, t);
-    }
+    hold_live_at_20kN(m, seq, t);
     for (int k = 0; k < 600; ++k) {
       t += 0.001;
       const double coast_kN = 0.6 * std::clamp((k - 25) / 100.0, 0.0, 1.0);

@@ -224,12 +224,13 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
                                   : 0.0;
   auto clamp_kN = [&](double x_rev) { return std::max(0.0, eol_->force_kN(x_rev, temperature_C, 0.0) + creep_kN); };
   auto pads_kN = [&](double x_rev) { return clamp_kN(x_rev) + lc_offset_kN; };
-  const double eol_keys_kN = eol_ ? pads_kN(x_keys_rev) : e.curve_force_kN;
+  const double keys_clamp_kN = eol_ ? clamp_kN(x_keys_rev) : 0.0;
+  const double eol_keys_kN = eol_ ? keys_clamp_kN + lc_offset_kN : e.curve_force_kN;
   // Keys whose friction grows with the clamp force (as the end-of-line test measured it: the
   // plant's load-dependent friction, key friction x (1 + gain F / F_ref)): the friction model and
   // every band of its width scale with the force where the keys are.
   friction_scale_ = eol_ && p.eol_friction_load_model && p.eol_friction_load_gain > 0.0
-                        ? 1.0 + p.eol_friction_load_gain * clamp_kN(x_keys_rev) / p.eol_friction_reference_kN
+                        ? 1.0 + p.eol_friction_load_gain * keys_clamp_kN / p.eol_friction_reference_kN
                         : 1.0;
   // The raw load cell against the curve at the position (the estimate is filtered: it hid noise
   // bursts of 0.35 kN RMS in held hard stops, issue 14); with an end-of-line curve, against it
