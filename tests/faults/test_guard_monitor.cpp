@@ -1795,6 +1795,31 @@ TEST(FaultMonitor, AHoldWhoseKeysKeptSlippingOneWayNeedsNoFrictionAllowance) {
               without.detected_s);
 }
 
+// The hold rule's friction allowance before the end-of-line friction model's state is known
+// (hold.friction_swing): keys whose elements slip only after 1.5-3 rev (so the 4.6 rev apply
+// leaves their state unknown) can move in a still hold by no more than their stiffness times the
+// resolver's noise, not by a half-width. A -0.6 kN/s drift from 4 s in the hold, never calibrated:
+// named once the change passes about 0.5 kN instead of 0.5 kN + the 1.5 kN half-width.
+TEST(FaultMonitor, AStillHoldBeforeTheKeysAreKnownNeedsOnlyTheFrictionItsSpanCanMove) {
+  auto run = [](bool swing, double drift_kN_per_s) {
+    MonitorParams p = eol_params(1.5, false);
+    p.eol_key_friction->threshold_distribution = bbw::plant::ThresholdDistribution::LogUniform;
+    p.eol_key_friction->threshold_min_rev = 1.5;
+    p.eol_key_friction->threshold_max_rev = 3.0;
+    p.hold_friction_swing = swing;
+    return drift_in_a_hold(p, drift_kN_per_s, [](double, double lc, double, double) { return uncalibrated(lc); });
+  };
+  const auto healthy = run(true, 0.0);
+  EXPECT_FALSE(healthy.present) << to_string(healthy.finding) << " at " << healthy.detected_s;
+  const auto with = run(true, -0.6);
+  const auto without = run(false, -0.6);
+  EXPECT_EQ(with.finding, Finding::LoadCellOffset) << to_string(with.finding);
+  EXPECT_LT(with.detected_s, 4.0 + 0.8 / 0.6);
+  EXPECT_TRUE(!without.present || without.detected_s > 4.0 + 1.9 / 0.6) << without.detected_s;
+  std::printf("a -0.6 kN/s drift from 4 s in a still hold, the keys' state unknown: named at %.3f s (one half-width: %s at %.3f s)\n",
+              with.detected_s, to_string(without.finding), without.detected_s);
+}
+
 // A calibrated corner modulated like an ABS (6 Hz, +-0.15 rev about 4.5 rev, up to 5.7 rev/s),
 // its calibrator right about the friction: the clamp curve `stiffness` x the end-of-line one, the
 // load cell `speed_kN_per_rev_per_s` x the speed off the clamp force (a sensor delay, viscous

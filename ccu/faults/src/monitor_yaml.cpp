@@ -57,6 +57,8 @@ MonitorParams read_monitor_params(Reader& r) {
     p.hold_calibrated = h.boolean("calibrated");
     p.hold_rebase = h.boolean("rebase");
     p.hold_friction_as_moved = h.boolean("friction_as_moved");
+    p.hold_friction_swing = h.boolean("friction_swing");
+    p.hold_restart_untrusted = h.boolean("restart_untrusted");
     h.finish();
   }
   {
@@ -196,6 +198,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.tracking_relative = k.number("relative", Range{0.0, 1.0, false, true});
   p.tracking_persist_s = k.number("persist_s", pos);
   p.tracking_full_speed_fraction = k.number("full_speed_fraction", config::Range::closed(0.0, 1.0));
+  p.tracking_excess_position_bound = k.boolean("excess_position_bound");
   p.force_limit_kN = k.number("force_limit_kN", pos);
   p.release_min_speed_rev_per_s = k.number("release_min_speed_rev_per_s", pos);
   k.finish();

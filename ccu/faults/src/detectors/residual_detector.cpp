@@ -42,6 +42,16 @@ ResidualDetector::ResidualDetector(const MonitorParams& p)
   }
 }
 
+double ResidualDetector::friction_swing_kN(double span_rev) const {
+  // Each element's force moves by K_i times its input's travel, at most across its whole range
+  // 2 K_i Delta_i; over inputs within a span, by at most K_i min(2 Delta_i, span).
+  double sum_kN = 0.0;
+  const auto& delta = eol_friction_->thresholds_rev();
+  const auto& k = eol_friction_->stiffness_kN_per_rev();
+  for (std::size_t i = 0; i < delta.size(); ++i) sum_kN += k[i] * std::min(2.0 * delta[i], span_rev);
+  return sum_kN;
+}
+
 double ResidualDetector::scaled_half_width_kN(const MonitorParams& p) const {
   return p.eol_friction_half_width_kN * friction_scale_;
 }
@@ -225,6 +235,11 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   auto clamp_kN = [&](double x_rev) { return std::max(0.0, eol_->force_kN(x_rev, temperature_C, 0.0) + creep_kN); };
   auto pads_kN = [&](double x_rev) { return clamp_kN(x_rev) + lc_offset_kN; };
   const double keys_clamp_kN = eol_ ? clamp_kN(x_keys_rev) : 0.0;
+  clamp_upper_kN_ = std::numeric_limits<double>::quiet_NaN();
+  if (eol_ && std::isfinite(r.position_rev)) {
+    const double f_hi_kN = clamp_kN(r.position_rev + 0.5 * p.eol_backlash_rev);
+    clamp_upper_kN_ = f_hi_kN + eol_allowance_kN(p, p.eol_band_kN, 0.0, f_hi_kN, r.speed_rev_per_s);
+  }
   const double eol_keys_kN = eol_ ? keys_clamp_kN + lc_offset_kN : e.curve_force_kN;
   // Keys whose friction grows with the clamp force (as the end-of-line test measured it: the
   // plant's load-dependent friction, key friction x (1 + gain F / F_ref)): the friction model and
@@ -305,6 +320,15 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     change_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
     have_reference_ = false;  // restarts where the curve is trusted again
     mod_definition_ = -1;
+    // With hold.restart_untrusted, so does the hold: its reference and the positions it spanned hold only for the samples it
+    // saw (extreme hunt run 44: a hold set at 2.22 s, the drive down to 0.94 rev below the trusted
+    // range and back, the keys' friction reversed by 2.1 kN, judged against the old level at 4.2 s).
+    if (p.hold_restart_untrusted) {
+      hold_ref_ = false;
+      hold_slow_ = 0;
+      hold_sum_kN_ = 0.0;
+      hold_last_kN_ = std::numeric_limits<double>::quiet_NaN();
+    }
     return;
   }
   double thr = 0.0, change_thr = 0.0;
@@ -442,6 +466,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     hold_r0_kN_ += residual_kN_ - hold_last_kN_;
     hold_x0_rev_ += x_hold - hold_last_x_rev_;
     hold_f0_kN_ += hold_curve_kN - hold_last_curve_kN_;
+    hold_x_min_rev_ += x_hold - hold_last_x_rev_;
+    hold_x_max_rev_ += x_hold - hold_last_x_rev_;
     if (hold_known_ != friction_known_) hold_friction_ref_ = false;  // its state just became known
     hold_eol_mode_ = eol_here;
     hold_known_ = friction_known_;
@@ -458,10 +484,13 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   bool hold_over = false;
   hold_change_kN_ = std::numeric_limits<double>::quiet_NaN();
   hold_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
+  const bool hold_was_set = hold_ref_;
   if (slow && !hold_ref_) {
     if (hold_slow_ == 0) {  // the definition the reference is averaged under
       hold_eol_mode_ = eol_here;
       hold_known_ = friction_known_;
+      hold_x_min_rev_ = hold_x_max_rev_ = x_hold;
+      hold_scale0_ = friction_scale_;
     }
     ++hold_slow_;
     hold_sum_kN_ += residual_kN_;
@@ -473,7 +502,12 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       hold_friction0_kN_ = scaled_friction_kN();
       hold_friction_ref_ = friction_known_;
     }
-  } else if (hold_ref_) {
+  }
+  if (slow) {
+    hold_x_min_rev_ = std::min(hold_x_min_rev_, x_hold);
+    hold_x_max_rev_ = std::max(hold_x_max_rev_, x_hold);
+  }
+  if (hold_was_set) {
     hold_change_kN_ = residual_kN_ - hold_r0_kN_;
     // The friction's uncertainty: its whole width while the model's state is unknown, else the
     // model's share of it; with hold.friction_as_moved, the share of what the model's friction
@@ -483,6 +517,12 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     if (friction_known_ && hold_friction_ref_ && p.hold_friction_as_moved) {
       const double moved_kN = std::abs(scaled_friction_kN() - hold_friction0_kN_);
       friction_kN = p.eol_friction_model_share * std::min(scaled_half_width_kN(p), moved_kN);
+    }
+    if (!friction_known_ && p.hold_friction_swing && eol_friction_) {
+      // The keys' state is unknown, but they can have moved no more than the positions spanned
+      // let them (a slow reversal: up to twice the half-width; a hold that stays put: little).
+      friction_kN = friction_scale_ * friction_swing_kN(hold_x_max_rev_ - hold_x_min_rev_) +
+                    std::abs(friction_scale_ - hold_scale0_) * eol_friction_half_width_kN_;
     }
     const double hold_thr = eol_allowance_kN(p, p.hold_kN, friction_kN, hold_curve_kN - hold_f0_kN_, r.speed_rev_per_s);
     hold_threshold_kN_ = hold_thr;

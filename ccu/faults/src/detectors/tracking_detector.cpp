@@ -8,7 +8,7 @@
 namespace bbw::faults {
 
 void TrackingDetector::update(const SampleContext& c, double force_estimate_kN, double friction_kN,
-                              const MonitorParams& p, DiagnosisArbiter& a) {
+                              double clamp_upper_kN, const MonitorParams& p, DiagnosisArbiter& a) {
   const CornerReading& r = c.r;
   const double t = r.time_s;
   const double cmd = r.force_command_kN;
@@ -48,7 +48,9 @@ void TrackingDetector::update(const SampleContext& c, double force_estimate_kN, 
   // Over-application: the brake holds a force well above what it is told and was told. Any
   // command counts (a brake told to release must release, whatever the force limit).
   const bool moving_back = r.speed_rev_per_s < -p.release_min_speed_rev_per_s;
-  if (!moving_back && force_estimate_kN + std::min(f, 0.0) - std::max(cmd, model_kN_) > limit) {
+  double held_kN = force_estimate_kN + std::min(f, 0.0);
+  if (p.tracking_excess_position_bound && std::isfinite(clamp_upper_kN)) held_kN = std::min(held_kN, clamp_upper_kN);
+  if (!moving_back && held_kN - std::max(cmd, model_kN_) > limit) {
     if (!excess_suspect_) {
       excess_suspect_ = true;
       excess_onset_s_ = t;

@@ -139,6 +139,16 @@ struct MonitorParams {
   // The hold's friction allowance: the friction model's share of what its friction moved since
   // the hold settled (at most the width), instead of the share of the whole width.
   bool hold_friction_as_moved = true;
+  // Before the end-of-line friction model's state is known, the hold's friction allowance is the
+  // most the model's Maxwell-slip elements can move over the positions the hold has spanned,
+  // sum K_i min(2 Delta_i, max x - min x) (times the load scale, plus the scale's own change
+  // times the half-width), instead of one half-width: a slow reversal within a hold swings the
+  // keys by up to twice the half-width; a hold that stays put, by almost nothing.
+  bool hold_friction_swing = true;
+  // The hold restarts wherever the residual is not judged (below the trusted range, no curve), as
+  // the change rule's reference does: its level and the positions it spanned hold only for the
+  // samples it saw.
+  bool hold_restart_untrusted = true;
   // Revisit rule: where the drive has been before, the load cell against the end-of-line curve
   // and friction model keeps the level it had there (the curve and the friction are the same
   // there, a load-cell drift is not). Per position bin of revisit_bin_rev and class (moving up,
@@ -485,6 +495,13 @@ struct MonitorParams {
   // An excess is a brake that does not release only while it does not move back at least this
   // fast (a brake that releases, if slowly, e.g. back-driven after a torque loss, moves).
   double release_min_speed_rev_per_s = 0.5;
+  // With an end-of-line curve and a resolver judged right, the excess counts a clamp force no
+  // higher than the curve allows where the keys can be furthest in (the measured position plus
+  // half the play; + end_of_line.relative and band, + its speed term): a load cell reading more
+  // than that is the keys' friction or its offset (a load-cell matter), not a brake holding force.
+  // A caliper at rest at its released position with 3.6 kN of friction stuck in its keys and a
+  // hot load cell's 0.65 kN read 4.2 kN against a zero command (extreme hunt run 193).
+  bool tracking_excess_position_bound = true;
 
   // Link: no sample for this long is a lost link (the DDS deadline in the process).
   double deadline_s = 0.015;

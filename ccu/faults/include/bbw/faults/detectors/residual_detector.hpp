@@ -108,6 +108,9 @@ class ResidualDetector {
   double change_kN() const { return change_kN_; }
   // The residual's change since the hold settled (NaN outside a hold).
   double hold_change_kN() const { return hold_change_kN_; }
+  // The most clamp force the end-of-line curve allows at the last sample's position (the motor's
+  // plus half the play, its creep; + relative, band and speed terms); NaN without a curve.
+  double clamp_upper_kN() const { return clamp_upper_kN_; }
   // The allowance that change was held against (kN; NaN outside a hold).
   double hold_threshold_kN() const { return hold_threshold_kN_; }
   // The revisit rule's change against the bin's level and its allowance (kN; NaN where the bin
@@ -194,6 +197,14 @@ class ResidualDetector {
   double hold_last_kN_ = std::numeric_limits<double>::quiet_NaN();
   double hold_last_x_rev_ = 0.0;
   double hold_last_curve_kN_ = 0.0;
+  // The key positions the hold has spanned since it began settling, and the load scale then
+  // (MonitorParams::hold_friction_swing).
+  double hold_x_min_rev_ = 0.0, hold_x_max_rev_ = 0.0;
+  double clamp_upper_kN_ = std::numeric_limits<double>::quiet_NaN();
+  double hold_scale0_ = 1.0;
+  // The most the end-of-line friction model's elements can move over a span of positions:
+  // sum K_i min(2 Delta_i, span) (kN, unscaled).
+  double friction_swing_kN(double span_rev) const;
   // The key friction's growth with the clamp force (MonitorParams::eol_friction_load_gain), this
   // sample's: the end-of-line friction model's force and its half-width times it.
   double friction_scale_ = 1.0;

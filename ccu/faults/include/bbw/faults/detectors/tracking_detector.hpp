@@ -5,6 +5,8 @@
 // trusted, else 0. The corner's loop holds its load cell at the command, so a healthy clamp force
 // stands off the command by that friction: the part of a shortfall or excess it explains is not
 // counted (a caliper with 3 kN of key friction held its clamp force 3 kN above a falling command).
+// `clamp_upper_kN`: the most clamp force the measured position allows (NaN: no bound); the excess
+// counts no force above it (MonitorParams::tracking_excess_position_bound).
 #pragma once
 
 #include "bbw/faults/detectors/detector.hpp"
@@ -13,8 +15,8 @@ namespace bbw::faults {
 
 class TrackingDetector {
  public:
-  void update(const SampleContext& c, double force_estimate_kN, double friction_kN, const MonitorParams& p,
-              DiagnosisArbiter& a);
+  void update(const SampleContext& c, double force_estimate_kN, double friction_kN, double clamp_upper_kN,
+              const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() {
     model_init_ = false;
     tracking_suspect_ = excess_suspect_ = false;
