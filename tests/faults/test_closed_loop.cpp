@@ -829,6 +829,36 @@ TEST(ClosedLoopIssue14, AHoldRestartsAfterTheDriveLeftTheTrustedRange) {
                                   [](MonitorParams& m) { m.hold_restart_untrusted = false; });
 }
 
+// A healthy 0.08 kN load cell that goes below the trusted range after a hard stop's release
+// (extreme hunt seed 2613, run 478): its second differences' level, learnt afresh when they took
+// over from the residual's steps (noise.paths_restart_learning), is its own; learnt from one
+// sample weighed by the residual path's time, it named load_cell_noisy at 2.196 s.
+TEST(ClosedLoopIssue14, ANoisyHealthyLoadCellReleasedLearnsItsOwnLevel) {
+  expect_quiet_only_with_the_rule("config/scenarios/faults/fault_free_noisy_load_cell_released.yaml",
+                                  "the noise paths restarting each other's learning", Finding::LoadCellNoisy,
+                                  [](MonitorParams& m) { m.noise_paths_restart_learning = false; });
+}
+
+// A drive seized as a hard stop applies (extreme hunt seed 2614, run 262): named, and nothing else.
+// The healthy FL, released from the hard stop, rests with its 3.9 kN keys pulling its load cell to
+// -3.9 kN against a zero command; the shortfall counts no clamp force below 0 nor below what the
+// end-of-line curve allows there (tracking.shortfall_position_bound). Without: actuator_tracking.
+TEST(ClosedLoopIssue14, KeysPullingALoadCellBelowZeroAreNotABrakeShortOfItsCommand) {
+  const auto fs = load("config/scenarios/faults/actuator_seized_in_a_hard_stop_beside_wide_keys.yaml");
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  EXPECT_TRUE(r.outcomes[0].detected) << to_string(r.outcomes[0].diagnosis);
+  EXPECT_EQ(r.faults_raised(), 1u);  // FR's
+  const std::size_t fl = 0;
+  EXPECT_FALSE(actuator(r, fl).present) << to_string(actuator(r, fl).finding);
+  auto opts = default_options();
+  opts.monitor.tracking_shortfall_position_bound = false;
+  const auto base = run_closed_loop(fs, opts);
+  EXPECT_EQ(actuator(base, fl).finding, Finding::ActuatorTracking) << to_string(actuator(base, fl).finding);
+  std::printf("seized FR beside wide keys: FL %s with the bound, %s without\n", to_string(actuator(r, fl).finding),
+              to_string(actuator(base, fl).finding));
+}
+
 // A total loss while a hard stop applies at the speed limit: the motor brakes with -40 A and the
 // rotor coasts on (tuning seed 1403 run 158). Named lost by the braking rule in its window; never
 // without it.

@@ -283,9 +283,13 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   }
   // The most clamp force the position allows, while the resolver is judged right.
   double clamp_upper_kN = std::numeric_limits<double>::quiet_NaN();
+  double clamp_lower_kN = std::numeric_limits<double>::quiet_NaN();
   if (estimate != nullptr && estimate->valid) {
     residual_.update(r, *estimate, p_, arbiter_, noise_, stuck_, jump_);
-    if (arbiter_.ok(Part::Resolver)) clamp_upper_kN = residual_.clamp_upper_kN();
+    if (arbiter_.ok(Part::Resolver)) {
+      clamp_upper_kN = residual_.clamp_upper_kN();
+      clamp_lower_kN = residual_.clamp_lower_kN();
+    }
   } else if (compensated && arbiter_.ok(Part::LoadCell) && check.load_cell_present && std::isfinite(r.force_kN)) {
     // No calibrator here (it is fed only with both sensors right): the end-of-line curve and band.
     calibration::Estimate eol_only;
@@ -311,7 +315,7 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   } else {
     const bool friction_known = estimate != nullptr && estimate->valid && estimate->calibrated && check.load_cell_present &&
                                 arbiter_.ok(Part::LoadCell);
-    tracking_.update(c, force_estimate_kN, friction_known ? estimate->friction_kN : 0.0, clamp_upper_kN, p_, arbiter_);
+    tracking_.update(c, force_estimate_kN, friction_known ? estimate->friction_kN : 0.0, clamp_upper_kN, clamp_lower_kN, p_, arbiter_);
   }
 
   prev_ = r;

@@ -143,6 +143,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.noise_learn_time_constant_s = n.number("learn_time_constant_s", pos);
   p.noise_second_difference_learn_s = n.number("second_difference_learn_s", pos);
   p.noise_released = n.boolean("released");
+  p.noise_paths_restart_learning = n.boolean("paths_restart_learning");
   n.finish();
 
   auto d = r.map("dropout");
@@ -199,6 +200,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.tracking_persist_s = k.number("persist_s", pos);
   p.tracking_full_speed_fraction = k.number("full_speed_fraction", config::Range::closed(0.0, 1.0));
   p.tracking_excess_position_bound = k.boolean("excess_position_bound");
+  p.tracking_shortfall_position_bound = k.boolean("shortfall_position_bound");
   p.force_limit_kN = k.number("force_limit_kN", pos);
   p.release_min_speed_rev_per_s = k.number("release_min_speed_rev_per_s", pos);
   k.finish();

@@ -9,6 +9,7 @@ namespace bbw::faults {
 
 void NoiseDetector::update(double residual_kN, double model_kN, double t, const MonitorParams& p, DiagnosisArbiter& a) {
   have_prev_difference_ = false;  // the difference path starts afresh when it is next used
+  if (p.noise_paths_restart_learning) second_level_.have_time = false;  // ... and its learning clock
   if (!have_prev_residual_) {
     have_prev_residual_ = true;
     prev_residual_kN_ = residual_kN;
@@ -45,6 +46,10 @@ void NoiseDetector::LearntLevel::learn(double value_kN, double t, bool quiet, do
 
 void NoiseDetector::update_load_cell_difference(double difference_kN, double t, const MonitorParams& p,
                                                 DiagnosisArbiter& a, bool before_learnt) {
+  if (p.noise_paths_restart_learning) {
+    have_prev_residual_ = false;  // the residual path starts afresh when it is next used
+    step_level_.have_time = false;
+  }
   if (!have_prev_difference_) {
     have_prev_difference_ = true;
     prev_difference_kN_ = difference_kN;

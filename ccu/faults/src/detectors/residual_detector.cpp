@@ -235,10 +235,12 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   auto clamp_kN = [&](double x_rev) { return std::max(0.0, eol_->force_kN(x_rev, temperature_C, 0.0) + creep_kN); };
   auto pads_kN = [&](double x_rev) { return clamp_kN(x_rev) + lc_offset_kN; };
   const double keys_clamp_kN = eol_ ? clamp_kN(x_keys_rev) : 0.0;
-  clamp_upper_kN_ = std::numeric_limits<double>::quiet_NaN();
+  clamp_upper_kN_ = clamp_lower_kN_ = std::numeric_limits<double>::quiet_NaN();
   if (eol_ && std::isfinite(r.position_rev)) {
     const double f_hi_kN = clamp_kN(r.position_rev + 0.5 * p.eol_backlash_rev);
     clamp_upper_kN_ = f_hi_kN + eol_allowance_kN(p, p.eol_band_kN, 0.0, f_hi_kN, r.speed_rev_per_s);
+    const double f_lo_kN = clamp_kN(r.position_rev - 0.5 * p.eol_backlash_rev);
+    clamp_lower_kN_ = f_lo_kN - eol_allowance_kN(p, p.eol_band_kN, 0.0, f_lo_kN, r.speed_rev_per_s);
   }
   const double eol_keys_kN = eol_ ? keys_clamp_kN + lc_offset_kN : e.curve_force_kN;
   // Keys whose friction grows with the clamp force (as the end-of-line test measured it: the

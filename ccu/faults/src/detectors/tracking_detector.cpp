@@ -8,7 +8,8 @@
 namespace bbw::faults {
 
 void TrackingDetector::update(const SampleContext& c, double force_estimate_kN, double friction_kN,
-                              double clamp_upper_kN, const MonitorParams& p, DiagnosisArbiter& a) {
+                              double clamp_upper_kN, double clamp_lower_kN, const MonitorParams& p,
+                              DiagnosisArbiter& a) {
   const CornerReading& r = c.r;
   const double t = r.time_s;
   const double cmd = r.force_command_kN;
@@ -36,7 +37,11 @@ void TrackingDetector::update(const SampleContext& c, double force_estimate_kN, 
   // Friction above zero holds the clamp force below the load cell (so below the command), below
   // zero above it.
   const double f = std::isfinite(friction_kN) ? friction_kN : 0.0;
-  if (reachable && std::min(cmd, model_kN_) - (force_estimate_kN + std::max(f, 0.0)) > limit) {
+  double reached_kN = force_estimate_kN + std::max(f, 0.0);
+  if (p.tracking_shortfall_position_bound) {
+    reached_kN = std::max(reached_kN, std::isfinite(clamp_lower_kN) ? std::max(0.0, clamp_lower_kN) : 0.0);
+  }
+  if (reachable && std::min(cmd, model_kN_) - reached_kN > limit) {
     if (!tracking_suspect_) {
       tracking_suspect_ = true;
       tracking_onset_s_ = t;

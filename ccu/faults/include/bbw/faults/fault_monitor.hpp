@@ -329,6 +329,13 @@ struct MonitorParams {
   // (noise_second_difference_learn_s) or the residual's: the fixed threshold raised 9 fault-free
   // findings in the first 0.1 s on the stress population's noisier load cells (stress seed 1406).
   bool noise_released = true;
+  // Each of the two paths (the residual's steps, the load cell's second differences) restarts
+  // the other's learning clock when it takes over: the first value after the other path ran is
+  // not weighed by the time the other path ran. Without it, the second differences' level after
+  // 0.5 s of residual steps was one sample's |value| (weight 1): a healthy 0.08 kN load cell's
+  // level learnt at 0.09 kN instead of 0.15 kN, and its second differences crossed the fixed
+  // 0.35 kN in 8 of 32 samples (extreme hunt seed 2613 run 478, load_cell_noisy while released).
+  bool noise_paths_restart_learning = true;
 
   // Dropout: consecutive samples without a load-cell value.
   int dropout_samples = 5;
@@ -502,6 +509,12 @@ struct MonitorParams {
   // A caliper at rest at its released position with 3.6 kN of friction stuck in its keys and a
   // hot load cell's 0.65 kN read 4.2 kN against a zero command (extreme hunt run 193).
   bool tracking_excess_position_bound = true;
+  // The shortfall, likewise, counts no less clamp force than 0 (the pads push, never pull) and,
+  // with an end-of-line curve and a resolver judged right, than the curve allows where the keys
+  // can be furthest out (the position less half the play; less relative, band and speed): a load
+  // cell reading less is the keys' friction pulling it (a caliper whose 3.9 kN keys read -3.9 kN
+  // at rest after a hard stop's release against a zero command, extreme hunt seed 2614 run 262).
+  bool tracking_shortfall_position_bound = true;
 
   // Link: no sample for this long is a lost link (the DDS deadline in the process).
   double deadline_s = 0.015;

@@ -111,6 +111,8 @@ class ResidualDetector {
   // The most clamp force the end-of-line curve allows at the last sample's position (the motor's
   // plus half the play, its creep; + relative, band and speed terms); NaN without a curve.
   double clamp_upper_kN() const { return clamp_upper_kN_; }
+  // The least: the curve at the motor's position less half the play, less the same terms.
+  double clamp_lower_kN() const { return clamp_lower_kN_; }
   // The allowance that change was held against (kN; NaN outside a hold).
   double hold_threshold_kN() const { return hold_threshold_kN_; }
   // The revisit rule's change against the bin's level and its allowance (kN; NaN where the bin
@@ -201,6 +203,7 @@ class ResidualDetector {
   // (MonitorParams::hold_friction_swing).
   double hold_x_min_rev_ = 0.0, hold_x_max_rev_ = 0.0;
   double clamp_upper_kN_ = std::numeric_limits<double>::quiet_NaN();
+  double clamp_lower_kN_ = std::numeric_limits<double>::quiet_NaN();
   double hold_scale0_ = 1.0;
   // The most the end-of-line friction model's elements can move over a span of positions:
   // sum K_i min(2 Delta_i, span) (kN, unscaled).

@@ -6,7 +6,8 @@
 // stands off the command by that friction: the part of a shortfall or excess it explains is not
 // counted (a caliper with 3 kN of key friction held its clamp force 3 kN above a falling command).
 // `clamp_upper_kN`: the most clamp force the measured position allows (NaN: no bound); the excess
-// counts no force above it (MonitorParams::tracking_excess_position_bound).
+// counts no force above it (MonitorParams::tracking_excess_position_bound). `clamp_lower_kN`: the
+// least (NaN: 0); the shortfall counts no force below it (tracking_shortfall_position_bound).
 #pragma once
 
 #include "bbw/faults/detectors/detector.hpp"
@@ -16,7 +17,7 @@ namespace bbw::faults {
 class TrackingDetector {
  public:
   void update(const SampleContext& c, double force_estimate_kN, double friction_kN, double clamp_upper_kN,
-              const MonitorParams& p, DiagnosisArbiter& a);
+              double clamp_lower_kN, const MonitorParams& p, DiagnosisArbiter& a);
   void on_rejoin() {
     model_init_ = false;
     tracking_suspect_ = excess_suspect_ = false;
