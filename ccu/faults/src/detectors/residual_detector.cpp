@@ -235,6 +235,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   auto clamp_kN = [&](double x_rev) { return std::max(0.0, eol_->force_kN(x_rev, temperature_C, 0.0) + creep_kN); };
   auto pads_kN = [&](double x_rev) { return clamp_kN(x_rev) + lc_offset_kN; };
   const double keys_clamp_kN = eol_ ? clamp_kN(x_keys_rev) : 0.0;
+  // The clamp force's bounds for the tracking rules: the curve where the keys can be furthest in
+  // and out (the motor's position +- half the play), with the curve's band, accuracy and speed.
   clamp_upper_kN_ = clamp_lower_kN_ = std::numeric_limits<double>::quiet_NaN();
   if (eol_ && std::isfinite(r.position_rev)) {
     const double f_hi_kN = clamp_kN(r.position_rev + 0.5 * p.eol_backlash_rev);
@@ -322,9 +324,10 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     change_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
     have_reference_ = false;  // restarts where the curve is trusted again
     mod_definition_ = -1;
-    // With hold.restart_untrusted, so does the hold: its reference and the positions it spanned hold only for the samples it
-    // saw (extreme hunt run 44: a hold set at 2.22 s, the drive down to 0.94 rev below the trusted
-    // range and back, the keys' friction reversed by 2.1 kN, judged against the old level at 4.2 s).
+    // With hold.restart_untrusted, so does the hold: its reference and the positions it spanned
+    // hold only for the samples it saw (extreme hunt run 44: a hold set at 2.22 s, the drive down
+    // to 0.94 rev below the trusted range and back, the keys' friction reversed by 2.1 kN, judged
+    // against the old level at 4.2 s).
     if (p.hold_restart_untrusted) {
       hold_ref_ = false;
       hold_slow_ = 0;
@@ -511,7 +514,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   }
   if (hold_was_set) {
     hold_change_kN_ = residual_kN_ - hold_r0_kN_;
-    // The friction's uncertainty: its whole width while the model's state is unknown, else the
+    // The friction's uncertainty: its half-width while the model's state is unknown (with
+    // hold.friction_swing, what its elements can move over the span, below), else the
     // model's share of it; with hold.friction_as_moved, the share of what the model's friction
     // moved since the hold settled (at most the width): keys that went on slipping the same way
     // (a drive creeping on into the load) kept their friction, in the model and on the caliper.

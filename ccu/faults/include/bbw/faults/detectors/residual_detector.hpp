@@ -202,12 +202,13 @@ class ResidualDetector {
   // The key positions the hold has spanned since it began settling, and the load scale then
   // (MonitorParams::hold_friction_swing).
   double hold_x_min_rev_ = 0.0, hold_x_max_rev_ = 0.0;
-  double clamp_upper_kN_ = std::numeric_limits<double>::quiet_NaN();
-  double clamp_lower_kN_ = std::numeric_limits<double>::quiet_NaN();
   double hold_scale0_ = 1.0;
   // The most the end-of-line friction model's elements can move over a span of positions:
   // sum K_i min(2 Delta_i, span) (kN, unscaled).
   double friction_swing_kN(double span_rev) const;
+  // The clamp force's bounds at the last sample's position (clamp_upper_kN(), clamp_lower_kN()).
+  double clamp_upper_kN_ = std::numeric_limits<double>::quiet_NaN();
+  double clamp_lower_kN_ = std::numeric_limits<double>::quiet_NaN();
   // The key friction's growth with the clamp force (MonitorParams::eol_friction_load_gain), this
   // sample's: the end-of-line friction model's force and its half-width times it.
   double friction_scale_ = 1.0;
