@@ -730,17 +730,24 @@ namespace {
 
 // A fault-free scenario of a caliper effect raises nothing with its end-of-line model and at least
 // one finding without it (`without`); the same scenario with a -1 kN bias is still named right.
-void expect_effect_model_holds(const char* fault_free, const char* biased, const char* model,
-                               const std::function<void(MonitorParams&)>& without) {
-  const auto fs = load(fault_free);
-  ASSERT_TRUE(fs.faults.empty());
-  const auto r = run_closed_loop(fs, default_options());
+// A fault-free scenario run with the shipped monitor (every finding it raises a failure, named
+// with `what`) and without a rule (`without`): the two runs.
+std::pair<LoopResult, LoopResult> fault_free_with_and_without(const char* scenario, const std::string& what,
+                                                              const std::function<void(MonitorParams&)>& without) {
+  const auto fs = load(scenario);
+  EXPECT_TRUE(fs.faults.empty()) << scenario;
+  auto r = run_closed_loop(fs, default_options());
   for (const auto& d : r.diagnoses) {
-    if (d.present) ADD_FAILURE() << "with the " << model << ": " << to_string(d.finding) << " at " << d.detected_s;
+    if (d.present) ADD_FAILURE() << "with " << what << ": " << to_string(d.finding) << " at " << d.detected_s;
   }
   auto opts = default_options();
   without(opts.monitor);
-  const auto base = run_closed_loop(fs, opts);
+  return {std::move(r), run_closed_loop(fs, opts)};
+}
+
+void expect_effect_model_holds(const char* fault_free, const char* biased, const char* model,
+                               const std::function<void(MonitorParams&)>& without) {
+  const auto [r, base] = fault_free_with_and_without(fault_free, std::string("the ") + model, without);
   EXPECT_GE(base.faults_raised(), 1u);
   const auto b = run_closed_loop(load(biased), default_options());
   ASSERT_EQ(b.outcomes.size(), 1u);
@@ -788,15 +795,7 @@ TEST(ClosedLoopIssue14, ALoadCellThatDriftsWithTemperatureRaisesNothingAndABiasI
 // nothing with it.
 void expect_quiet_only_with_the_rule(const char* scenario, const char* rule, Finding finding,
                                      const std::function<void(MonitorParams&)>& without) {
-  const auto fs = load(scenario);
-  ASSERT_TRUE(fs.faults.empty());
-  const auto r = run_closed_loop(fs, default_options());
-  for (const auto& d : r.diagnoses) {
-    if (d.present) ADD_FAILURE() << "with " << rule << ": " << to_string(d.finding) << " at " << d.detected_s;
-  }
-  auto opts = default_options();
-  without(opts.monitor);
-  const auto base = run_closed_loop(fs, opts);
+  const auto [r, base] = fault_free_with_and_without(scenario, rule, without);
   std::size_t named = 0;
   for (const auto& d : base.diagnoses) {
     if (d.present && d.finding == finding) ++named;

@@ -238,7 +238,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // The clamp force's bounds for the tracking rules: the curve where the keys can be furthest in
   // and out (the motor's position +- half the play), with the curve's band, accuracy and speed.
   clamp_upper_kN_ = clamp_lower_kN_ = std::numeric_limits<double>::quiet_NaN();
-  if (eol_ && std::isfinite(r.position_rev)) {
+  if (eol_ && std::isfinite(r.position_rev) && (p.tracking_excess_position_bound || p.tracking_shortfall_position_bound)) {
     const double f_hi_kN = clamp_kN(r.position_rev + 0.5 * p.eol_backlash_rev);
     clamp_upper_kN_ = f_hi_kN + eol_allowance_kN(p, p.eol_band_kN, 0.0, f_hi_kN, r.speed_rev_per_s);
     const double f_lo_kN = clamp_kN(r.position_rev - 0.5 * p.eol_backlash_rev);
