@@ -360,7 +360,9 @@ void CcuApp::drain_qos_events(double now_s, bool lockstep) {
       if (e.kind == dds::QosEvent::Kind::DeadlineMissed) {
         if (e.handle == instances_[i]) node_.on_deadline_missed(i, t, lockstep);
       } else if (e.kind == dds::QosEvent::Kind::LivelinessLost || e.kind == dds::QosEvent::Kind::WriterLost) {
-        node_.on_writer_lost(i, dds::endpoint_id(e.handle), t, lockstep);
+        node_.on_writer_lost(i, dds::endpoint_id(e.handle), t, lockstep,
+                             e.kind == dds::QosEvent::Kind::WriterLost ? node::CcuNode::WriterLoss::Left
+                                                                       : node::CcuNode::WriterLoss::LeaseLapsed);
       } else if (e.kind == dds::QosEvent::Kind::LivelinessRecovered) {
         node_.on_writer_recovered(i, dds::endpoint_id(e.handle));
       }

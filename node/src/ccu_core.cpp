@@ -73,6 +73,9 @@ faults::MonitorParams corner_monitor_params(const scenario::Scenario& scenario, 
   const auto& thermal = corner.effects.thermal_drift;
   corner_mp.eol_load_cell_kN_per_C = thermal.enabled ? thermal.offset_kN_per_C : 0.0;
   corner_mp.eol_load_cell_reference_C = thermal.reference_temperature_C;
+  // And its drive's viscous friction (0: none).
+  const auto& viscous = corner.effects.viscous_friction;
+  corner_mp.eol_viscous_kN_per_rev_per_s = viscous.enabled ? viscous.coefficient_kN_per_rev_per_s : 0.0;
   return corner_mp;
 }
 

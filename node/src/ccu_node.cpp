@@ -169,6 +169,7 @@ void CcuNode::on_block(std::size_t i, const msg::MeasurementBlock& b, transport:
   if (!ch.have_writer || ch.writer != writer) {
     ch.writer = writer;
     ch.have_writer = true;
+    ch.writer_left = false;
     barrier_.set_alive(ch.barrier, true);
   }
   if (b.incarnation() != ch.incarnation) {
@@ -212,10 +213,24 @@ void CcuNode::on_deadline_missed(std::size_t i, double time_s, bool lockstep) {
   if (!lockstep) core_.on_link_event(ch.slot, faults::LinkEvent::DeadlineMissed, time_s);
 }
 
-void CcuNode::on_writer_lost(std::size_t i, transport::EndpointId writer, double time_s, bool lockstep) {
+void CcuNode::on_writer_lost(std::size_t i, transport::EndpointId writer, double time_s, bool lockstep, WriterLoss how) {
   CornerChannel& ch = channels_[i];
-  if (!ch.have_writer || ch.finished || writer != ch.writer || !barrier_.alive(ch.barrier)) return;
-  ++ch.liveliness_lost;
+  if (!ch.have_writer || ch.finished || writer != ch.writer) return;
+  const bool was_alive = barrier_.alive(ch.barrier);
+  if (how == WriterLoss::LeaseLapsed) {
+    // Real time: a lapse is a lost link until the writer leaves or a new process joins (a corner
+    // never killed was once named process_lost in SystemFaultsRealtime's restart test, beside the
+    // restarting one). Lockstep: the writer is taken as gone, as before (its 2 s lease).
+    if (!was_alive) return;
+    ++ch.liveliness_lost;
+    barrier_.set_alive(ch.barrier, false);
+    if (!lockstep) core_.on_link_event(ch.slot, faults::LinkEvent::LeaseLapsed, time_s);
+    return;
+  }
+  // Gone: also after a lapse (its link already lost), but once per writer.
+  if (ch.writer_left) return;
+  ch.writer_left = true;
+  if (was_alive) ++ch.liveliness_lost;
   barrier_.set_alive(ch.barrier, false);
   if (!lockstep) core_.on_link_event(ch.slot, faults::LinkEvent::LivelinessLost, time_s);
 }

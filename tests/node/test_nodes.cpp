@@ -197,6 +197,36 @@ TEST(CcuNode, TheRealtimeEndWaitsForALateCornerButNotForALostOne) {
   EXPECT_TRUE(ccu.all_linked_finished()) << "the lost corner is not waited for";
 }
 
+// Real time: a corner whose writer's own liveliness lease (30 ms) lapsed is a lost link, not a
+// lost process: a process stalled on a loaded machine lapses it as a dead one does. The process is
+// named once its writer is gone (its participant's lease, or a restart), also after such a lapse.
+TEST(CcuNode, ALapsedLeaseIsALostLinkAndAGoneWriterALostProcess) {
+  const auto fs = load("config/scenarios/vehicle_stop.yaml");
+  CcuNode ccu(fs.scenario, test::robust_config(), true);
+  msg::MeasurementBlock b;
+  b.block_seq(0);
+  for (std::size_t i = 0; i < ccu.channels(); ++i) {
+    b.corner_id(static_cast<std::uint8_t>(ccu.channel(i).slot));
+    ccu.on_block(i, b, 10 + i, 0.005);
+  }
+  const auto& m = ccu.core().supervisor(ccu.channel(1).slot).monitor();
+  ccu.on_writer_lost(1, 11, 0.040, false, CcuNode::WriterLoss::LeaseLapsed);
+  EXPECT_FALSE(m.ok(faults::Part::Network)) << "a lapsed lease is a lost link";
+  EXPECT_TRUE(m.ok(faults::Part::Process)) << "a lapsed lease alone names no process";
+  EXPECT_EQ(ccu.channel(1).liveliness_lost, 1u);
+  ccu.on_writer_lost(1, 11, 2.0, false, CcuNode::WriterLoss::Left);
+  EXPECT_FALSE(m.ok(faults::Part::Process)) << "a writer gone after its lease lapsed is a lost process";
+  EXPECT_EQ(m.diagnosis(faults::Part::Process).onset_s, m.diagnosis(faults::Part::Network).onset_s)
+      << "the outage began when the link was lost, not when the writer left";
+  EXPECT_LT(m.diagnosis(faults::Part::Process).onset_s, 1.0);
+  EXPECT_EQ(ccu.channel(1).liveliness_lost, 1u) << "one loss of one writer";
+  // A writer gone at once (no lapse first) names the process too.
+  const auto& m2 = ccu.core().supervisor(ccu.channel(2).slot).monitor();
+  ccu.on_writer_lost(2, 12, 2.0, false);
+  EXPECT_FALSE(m2.ok(faults::Part::Process));
+  EXPECT_EQ(ccu.channel(2).liveliness_lost, 1u);
+}
+
 TEST(CcuNode, CommandsCarryTheCalibratorsFrictionEstimate) {
   const auto fs = load("config/scenarios/four_corner_rig.yaml");
   CcuNode ccu(fs.scenario, test::robust_config(), true);

@@ -24,6 +24,9 @@ double friction_amplitude_kN(const calibration::FrictionParams& f) {
 MonitorParams with_curve_range(MonitorParams p, const calibration::CalibratorConfig& c) {
   p.curve_min_rev = c.x_min_rev;
   p.curve_max_rev = c.x_max_rev;
+  // A calibrator that fits its own viscous term has it in its friction: the monitor's end-of-line
+  // viscous model would count it twice (MonitorParams::eol_viscous_model).
+  if (c.viscous_friction) p.eol_viscous_kN_per_rev_per_s = 0.0;
   return p;
 }
 

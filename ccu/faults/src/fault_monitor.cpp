@@ -54,6 +54,8 @@ void MonitorParams::validate() const {
           eol_friction_load_gain, "must be >= 0");
   positive("eol_friction_reference_kN", eol_friction_reference_kN);
   require(std::isfinite(eol_load_cell_kN_per_C), "eol_load_cell_kN_per_C", eol_load_cell_kN_per_C, "must be finite");
+  require(std::isfinite(eol_viscous_kN_per_rev_per_s) && eol_viscous_kN_per_rev_per_s >= 0.0, "eol_viscous_kN_per_rev_per_s",
+          eol_viscous_kN_per_rev_per_s, "must be >= 0");
   require(std::isfinite(eol_load_cell_reference_C), "eol_load_cell_reference_C", eol_load_cell_reference_C, "must be finite");
   require(std::isfinite(eol_friction_model_share) && eol_friction_model_share >= 0.0 && eol_friction_model_share <= 1.0,
           "eol_friction_model_share", eol_friction_model_share, "must be in [0, 1]");
@@ -218,8 +220,29 @@ Part part_of(Finding f) {
   }
 }
 
+namespace {
+
+// The corner's parameters as its monitor uses them. The residual rules' speed allowances
+// (residual.speed_kN_per_rev_per_s, end_of_line.speed_kN_per_rev_per_s: 0.3 = viscous friction
+// 0.2 + a load cell's 5 ms delay 0.1) are for speed effects no model carries: with
+// eol_viscous_narrows_speed_allowance, a viscous term the end-of-line model puts in the expected
+// reading is taken out of them (tune run 22, tune_b run 554: a positive drift in a fast apply,
+// named only because the viscous term added to it, was missed once the model took the term out
+// and the allowance still held it).
+MonitorParams for_corner(const MonitorParams& params) {
+  params.validate();
+  MonitorParams p = params;
+  if (p.eol_viscous_model && p.eol_viscous_narrows_speed_allowance && p.eol_curve) {
+    p.residual_speed_kN_per_rev_per_s = std::max(0.0, p.residual_speed_kN_per_rev_per_s - p.eol_viscous_kN_per_rev_per_s);
+    p.eol_speed_kN_per_rev_per_s = std::max(0.0, p.eol_speed_kN_per_rev_per_s - p.eol_viscous_kN_per_rev_per_s);
+  }
+  return p;
+}
+
+}  // namespace
+
 FaultMonitor::FaultMonitor(const MonitorParams& params, Target corner)
-    : p_((params.validate(), params)), corner_(corner), residual_(params), torque_(params), step_(params), moving_step_(params) {
+    : p_(for_corner(params)), corner_(corner), residual_(p_), torque_(p_), step_(p_), moving_step_(p_) {
   if (!corner_slot(corner)) throw std::invalid_argument("FaultMonitor: monitors a corner, not the CCU");
 }
 

@@ -43,6 +43,8 @@ MonitorParams read_monitor_params(Reader& r) {
     p.eol_creep_model = eol.boolean("creep_model");
     p.eol_friction_load_model = eol.boolean("friction_load_model");
     p.eol_thermal_offset_model = eol.boolean("thermal_offset_model");
+    p.eol_viscous_model = eol.boolean("viscous_model");
+    p.eol_viscous_narrows_speed_allowance = eol.boolean("viscous_narrows_speed_allowance");
     p.calibrated_two_friction_models = eol.boolean("calibrated_two_friction_models");
     p.calibrated_capped_by_eol = eol.boolean("calibrated_capped");
     eol.finish();

@@ -27,6 +27,7 @@ bool LinkDetector::take_rejoin() {
 void LinkDetector::on_link_event(LinkEvent e, double time_s, DiagnosisArbiter& a) {
   switch (e) {
     case LinkEvent::DeadlineMissed:
+    case LinkEvent::LeaseLapsed:
       if (a.ok(Part::Process)) a.confirm(Finding::LinkLost, any_arrival_ ? last_arrival_s_ : time_s, time_s);
       break;
     case LinkEvent::LivelinessLost:

@@ -75,6 +75,7 @@ void ResidualDetector::step_creep(double x_rev, const CornerReading& r, const Mo
 
 void ResidualDetector::track_position(const CornerReading& r, const MonitorParams& p) {
   if (!eol_friction_) {
+    spindle_moved_ = true;  // no play modelled: the spindle is the motor
     step_creep(r.position_rev, r, p);
     return;
   }
@@ -88,8 +89,11 @@ void ResidualDetector::track_position(const CornerReading& r, const MonitorParam
     eol_friction_->reset(r.position_rev);
     x_min_rev_ = x_max_rev_ = r.position_rev;
   }
+  const double spindle_before_rev = spindle_rev_;
   if (p.eol_backlash_rev > 0.0) model::play_step(spindle_rev_, r.position_rev, p.eol_backlash_rev);
   else spindle_rev_ = r.position_rev;
+  // The spindle moves with the motor at the play's edge; within the play it stands.
+  spindle_moved_ = p.eol_backlash_rev <= 0.0 || spindle_rev_ != spindle_before_rev;
   eol_friction_kN_ = eol_friction_->step(spindle_rev_);
   x_min_rev_ = std::min(x_min_rev_, r.position_rev);
   x_max_rev_ = std::max(x_max_rev_, r.position_rev);
@@ -229,9 +233,16 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // pull (the plant's clamp force is at least 0). The load cell's offset with temperature (as the
   // end-of-line test measured it; 0 without) is part of what it reads there.
   const double creep_kN = eol_ ? creep_kN_ : 0.0;
-  const double lc_offset_kN = eol_ && p.eol_thermal_offset_model
-                                  ? p.eol_load_cell_kN_per_C * (temperature_C - p.eol_load_cell_reference_C)
-                                  : 0.0;
+  // So is the drive's viscous friction while the spindle moves (as the end-of-line test measured
+  // it, on the motor's measured speed; 0 without, or while the motor crosses the play).
+  const double viscous_kN = eol_ && p.eol_viscous_model && p.eol_viscous_kN_per_rev_per_s > 0.0 && spindle_moved_ &&
+                                    std::isfinite(r.speed_rev_per_s)
+                                ? p.eol_viscous_kN_per_rev_per_s * r.speed_rev_per_s
+                                : 0.0;
+  const double lc_offset_kN = (eol_ && p.eol_thermal_offset_model
+                                   ? p.eol_load_cell_kN_per_C * (temperature_C - p.eol_load_cell_reference_C)
+                                   : 0.0) +
+                              viscous_kN;
   auto clamp_kN = [&](double x_rev) { return std::max(0.0, eol_->force_kN(x_rev, temperature_C, 0.0) + creep_kN); };
   auto pads_kN = [&](double x_rev) { return clamp_kN(x_rev) + lc_offset_kN; };
   const double keys_clamp_kN = eol_ ? clamp_kN(x_keys_rev) : 0.0;

@@ -71,6 +71,7 @@ struct CornerChannel {
   bool finished = false;               // received the last block
   bool have_writer = false;
   transport::EndpointId writer = 0;    // the current incarnation's measurement writer
+  bool writer_left = false;            // that writer is gone (not only its lease lapsed)
   int health = -1;
   std::uint32_t health_incarnation = 0;
   std::array<faults::Diagnosis, 5> seen{};  // last diagnoses recorded (detection log)
@@ -114,7 +115,11 @@ class CcuNode {
   // or recovered). Lockstep only counts them (time is simulated; tick() finds a silent corner,
   // and a lost writer is acted on at the period's end, end_lockstep_period()).
   void on_deadline_missed(std::size_t channel, double time_s, bool lockstep);
-  void on_writer_lost(std::size_t channel, transport::EndpointId writer, double time_s, bool lockstep);
+  // How a writer was lost: it left (its participant's lease ran out, or it was deleted), or its
+  // own liveliness lease lapsed (a lost link in real time: faults::LinkEvent::LeaseLapsed).
+  enum class WriterLoss : std::uint8_t { Left, LeaseLapsed };
+  void on_writer_lost(std::size_t channel, transport::EndpointId writer, double time_s, bool lockstep,
+                      WriterLoss how = WriterLoss::Left);
   void on_writer_recovered(std::size_t channel, transport::EndpointId writer);
   // Lockstep: a restarted corner has announced itself; its block is expected from now on.
   void expect_rejoin(std::size_t channel);

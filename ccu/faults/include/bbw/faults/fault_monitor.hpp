@@ -112,6 +112,19 @@ struct MonitorParams {
   // the end-of-line test measured it (CcuCore sets the corner's; 0: none): with
   // eol_thermal_offset_model the residual rules expect it in the load cell's reading.
   bool eol_thermal_offset_model = true;
+  // The drive's viscous friction (the plant's c_v v, on the spindle's speed), as the end-of-line
+  // test measured it (CcuCore sets the corner's; 0: none, and 0 when the calibrator fits its own
+  // viscous term): with eol_viscous_model the residual rules expect it in the load cell's reading
+  // while the spindle moves (the motor's measured speed, 0 while the motor crosses the play).
+  // Without, a calibrated viscous caliper reversing from a -2 rev/s release into a +2.7 rev/s
+  // apply moved its residual by 0.55 kN against the change rule's 0.48 kN (extreme hunt seed 2613
+  // run 18, a fault-free finding).
+  bool eol_viscous_model = true;
+  // ... and the residual rules' speed allowances, for speed effects no model carries, are narrowed
+  // by the viscous term the model carries (FaultMonitor takes it out of residual_speed_kN_per_rev_per_s
+  // and eol_speed_kN_per_rev_per_s).
+  bool eol_viscous_narrows_speed_allowance = true;
+  double eol_viscous_kN_per_rev_per_s = 0.0;
   double eol_load_cell_kN_per_C = 0.0;
   double eol_load_cell_reference_C = 40.0;
   double eol_friction_load_gain = 0.0;

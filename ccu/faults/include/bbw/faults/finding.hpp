@@ -37,6 +37,10 @@ struct Diagnosis {
 
 // Restarted: a new process of the corner (a higher incarnation) has sent its first samples, so
 // the one before it is gone: an outage still open is the process's death, not the link's.
-enum class LinkEvent : std::uint8_t { DeadlineMissed, LivelinessLost, LivelinessRecovered, Restarted };
+// LivelinessLost: the corner's writer is gone (its participant's lease ran out or it left).
+// LeaseLapsed: the writer's own liveliness lease (realtime: 30 ms) lapsed; that cannot tell a
+// process stalled on a loaded machine, or a late link, from a dead one, so it is a lost link (as a
+// missed deadline), and the process is named only when its writer is gone or it restarts.
+enum class LinkEvent : std::uint8_t { DeadlineMissed, LivelinessLost, LivelinessRecovered, Restarted, LeaseLapsed };
 
 }  // namespace bbw::faults

@@ -175,6 +175,7 @@ class ResidualDetector {
   double x_min_rev_ = 0.0, x_max_rev_ = 0.0;  // since the start or the last gap
   double eol_friction_kN_ = 0.0;
   double spindle_rev_ = 0.0;  // the play operator's state (backlash)
+  bool spindle_moved_ = true;  // in the last sample (the viscous term's; MonitorParams::eol_viscous_model)
   // The position's state, one list for saving and taking it back.
   std::tuple<std::optional<plant::KeyFriction>&, bool&, bool&, double&, double&, double&, double&> position_state() {
     return std::tie(eol_friction_, friction_known_, have_x_, x_min_rev_, x_max_rev_, eol_friction_kN_, spindle_rev_);
