@@ -213,7 +213,7 @@ bool InProcessRun::step() {
     for (std::size_t i = 0; i < corners_.size(); ++i) {
       CornerEnd& c = corners_[i];
       if (!c.lost_writer) continue;
-      ccu_.on_writer_lost(i, *c.lost_writer, t_end, true);
+      ccu_.on_writer_lost(i, *c.lost_writer, t_end, true, CcuNode::WriterLoss::Left);
       c.lost_writer.reset();
     }
     if (!ccu_.period_complete(k)) {

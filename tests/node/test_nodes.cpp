@@ -160,9 +160,9 @@ TEST(CcuNode, TheBarrierWaitsForEveryCornerUnlessItsWriterIsGone) {
     ccu.on_block(i, b, 10 + i, 0.010);
   }
   EXPECT_FALSE(ccu.period_complete(1));
-  ccu.on_writer_lost(last, 99, 0.010, true);  // not its writer: nothing changes
+  ccu.on_writer_lost(last, 99, 0.010, true, CcuNode::WriterLoss::Left);  // not its writer: nothing changes
   EXPECT_FALSE(ccu.period_complete(1));
-  ccu.on_writer_lost(last, 42, 0.010, true);
+  ccu.on_writer_lost(last, 42, 0.010, true, CcuNode::WriterLoss::Left);
   EXPECT_TRUE(ccu.period_complete(1));
   EXPECT_EQ(ccu.channel(last).liveliness_lost, 1u);
 }
@@ -185,7 +185,7 @@ TEST(CcuNode, TheRealtimeEndWaitsForALateCornerButNotForALostOne) {
   // Corner 0 is late (deadline missed: link_lost), corner 1's writer is gone; the others finish.
   ccu.on_deadline_missed(0, 0.5, false);
   ASSERT_FALSE(ccu.core().supervisor(ccu.channel(0).slot).monitor().ok(faults::Part::Network));
-  ccu.on_writer_lost(1, 11, 0.5, false);
+  ccu.on_writer_lost(1, 11, 0.5, false, CcuNode::WriterLoss::Left);
   b.block_seq(last_block);
   for (std::size_t i = 2; i < ccu.channels(); ++i) {
     b.corner_id(static_cast<std::uint8_t>(ccu.channel(i).slot));
@@ -222,7 +222,7 @@ TEST(CcuNode, ALapsedLeaseIsALostLinkAndAGoneWriterALostProcess) {
   EXPECT_EQ(ccu.channel(1).liveliness_lost, 1u) << "one loss of one writer";
   // A writer gone at once (no lapse first) names the process too.
   const auto& m2 = ccu.core().supervisor(ccu.channel(2).slot).monitor();
-  ccu.on_writer_lost(2, 12, 2.0, false);
+  ccu.on_writer_lost(2, 12, 2.0, false, CcuNode::WriterLoss::Left);
   EXPECT_FALSE(m2.ok(faults::Part::Process));
   EXPECT_EQ(ccu.channel(2).liveliness_lost, 1u);
 }

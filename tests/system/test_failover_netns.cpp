@@ -428,8 +428,19 @@ TEST(SystemFailoverNetns, SplitBrainEachCornerObeysOneCcu) {
       std::cout << "[ NOTE     ] " << s.corner << " entered its safe state at " << in.corners[i].ccu_lost_s
                 << " s while both CCUs were stalled together (a machine stall, not split brain)" << std::endl;
     } else {
+      // On a failure, both CCUs' stalls on the corner's clock (s after its start), beside when it
+      // entered its safe state: whether they overlapped, and for how long, says if the machine did it.
+      auto on_clock = [&](const std::vector<bbw::runtime::StallInterval>& v) {
+        std::string out;
+        for (const auto& st : v) {
+          out += " " + std::to_string(st.from_mono_s - in.primary.t0_mono_s) + "-" + std::to_string(st.to_mono_s - in.primary.t0_mono_s);
+        }
+        return out;
+      };
       EXPECT_LT(in.corners[i].ccu_lost_s, 0.0) << s.corner << ": safe state entered\nthe primary's stalls (" << in.primary.stalls
-                                               << "), the standby's (" << in.standby.stalls << ")\n" << c.logs();
+                                               << "):" << on_clock(primary_stalls) << "\nthe standby's (" << in.standby.stalls
+                                               << "):" << on_clock(standby_stalls) << "\nits switches of CCU (the split at "
+                                               << split_mono_s - in.primary.t0_mono_s << " s on that clock):\n" << trail << c.logs();
     }
   }
   // FL's takeover by the standby: within the goal, measured from the split.

@@ -21,7 +21,9 @@ double friction_amplitude_kN(const calibration::FrictionParams& f) {
   return sum;
 }
 
-MonitorParams with_curve_range(MonitorParams p, const calibration::CalibratorConfig& c) {
+// The monitor's parameters beside this calibrator: its curve's range, and no viscous model of its
+// own when the calibrator fits one.
+MonitorParams for_calibrator(MonitorParams p, const calibration::CalibratorConfig& c) {
   p.curve_min_rev = c.x_min_rev;
   p.curve_max_rev = c.x_max_rev;
   // A calibrator that fits its own viscous term has it in its friction: the monitor's end-of-line
@@ -48,7 +50,7 @@ CornerSupervisor::CornerSupervisor(const calibration::CalibratorConfig& calibrat
       corner_(corner),
       guard_(monitor.guard),
       calibrator_(std::in_place, calibrator),
-      monitor_(with_curve_range(monitor, calibrator), corner),
+      monitor_(for_calibrator(monitor, calibrator), corner),
       last_good_(*calibrator_),
       trusted_curve_(calibrator.initial_curve) {
   view_.curve = trusted_curve_;

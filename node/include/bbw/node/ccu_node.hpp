@@ -119,7 +119,7 @@ class CcuNode {
   // own liveliness lease lapsed (a lost link in real time: faults::LinkEvent::LeaseLapsed).
   enum class WriterLoss : std::uint8_t { Left, LeaseLapsed };
   void on_writer_lost(std::size_t channel, transport::EndpointId writer, double time_s, bool lockstep,
-                      WriterLoss how = WriterLoss::Left);
+                      WriterLoss how);
   void on_writer_recovered(std::size_t channel, transport::EndpointId writer);
   // Lockstep: a restarted corner has announced itself; its block is expected from now on.
   void expect_rejoin(std::size_t channel);
