@@ -397,6 +397,14 @@ TEST(SystemFailoverNetns, SplitBrainEachCornerObeysOneCcu) {
     }
     return false;
   };
+  // Stalls as "from to to s" after the split, as the switches are listed.
+  auto after_split = [&](const std::vector<bbw::runtime::StallInterval>& v) {
+    std::string out;
+    for (const auto& st : v) {
+      out += "  " + std::to_string(st.from_mono_s - split_mono_s) + " to " + std::to_string(st.to_mono_s - split_mono_s) + " s\n";
+    }
+    return out;
+  };
   int stall_visits = 0;
   for (std::size_t i = 0; i < in.corners.size(); ++i) {
     const auto& s = in.corners[i].owners;
@@ -413,13 +421,9 @@ TEST(SystemFailoverNetns, SplitBrainEachCornerObeysOneCcu) {
       if (s.corner != "FL" && explained(sw) && back_soon) ++stall_visits;
       else unexplained += line;
     }
-    std::string stalls;
-    for (const auto& st : in.primary.stall_intervals) {
-      stalls += "  " + std::to_string(st.from_mono_s - split_mono_s) + " to " + std::to_string(st.to_mono_s - split_mono_s) + " s\n";
-    }
     EXPECT_EQ(owner_in(s, split_mono_s + settle_s, split_mono_s + settle_s), expected) << s.corner << " as the split settled";
     EXPECT_EQ(unexplained, "") << s.corner << " went to another CCU during the split without a stall to explain it; its switches:\n"
-                               << trail << "the primary's stalls (" << in.primary.stalls << "):\n" << stalls << c.logs();
+                               << trail << "the primary's stalls (" << in.primary.stalls << "):\n" << after_split(in.primary.stall_intervals) << c.logs();
     EXPECT_EQ(owner_in(s, heal_mono_s + 0.5, 1e12), "primary") << s.corner << " after the split healed\n" << c.logs();
     if (in.corners[i].ccu_lost_s >= 0.0 && stalled_together(in.corners[i].ccu_lost_s)) {
       // Both CCUs silent at once for the corner's watchdog timeout: the machine stalled (a
@@ -428,19 +432,13 @@ TEST(SystemFailoverNetns, SplitBrainEachCornerObeysOneCcu) {
       std::cout << "[ NOTE     ] " << s.corner << " entered its safe state at " << in.corners[i].ccu_lost_s
                 << " s while both CCUs were stalled together (a machine stall, not split brain)" << std::endl;
     } else {
-      // On a failure, both CCUs' stalls on the corner's clock (s after its start), beside when it
-      // entered its safe state: whether they overlapped, and for how long, says if the machine did it.
-      auto on_clock = [&](const std::vector<bbw::runtime::StallInterval>& v) {
-        std::string out;
-        for (const auto& st : v) {
-          out += " " + std::to_string(st.from_mono_s - in.primary.t0_mono_s) + "-" + std::to_string(st.to_mono_s - in.primary.t0_mono_s);
-        }
-        return out;
-      };
-      EXPECT_LT(in.corners[i].ccu_lost_s, 0.0) << s.corner << ": safe state entered\nthe primary's stalls (" << in.primary.stalls
-                                               << "):" << on_clock(primary_stalls) << "\nthe standby's (" << in.standby.stalls
-                                               << "):" << on_clock(standby_stalls) << "\nits switches of CCU (the split at "
-                                               << split_mono_s - in.primary.t0_mono_s << " s on that clock):\n" << trail << c.logs();
+      // On a failure, both CCUs' stalls beside when the corner entered its safe state (all after
+      // the split): whether they overlapped, and for how long, says if the machine did it.
+      EXPECT_LT(in.corners[i].ccu_lost_s, 0.0)
+          << s.corner << ": safe state entered at " << in.primary.t0_mono_s + in.corners[i].ccu_lost_s - split_mono_s
+          << " s after the split\nthe primary's stalls (" << in.primary.stalls << "):\n" << after_split(primary_stalls)
+          << "the standby's (" << in.standby.stalls << "):\n" << after_split(standby_stalls) << "its switches of CCU:\n"
+          << trail << c.logs();
     }
   }
   // FL's takeover by the standby: within the goal, measured from the split.

@@ -232,7 +232,9 @@ namespace {
 MonitorParams for_corner(const MonitorParams& params) {
   params.validate();
   MonitorParams p = params;
-  if (p.eol_viscous_model && p.eol_viscous_narrows_speed_allowance && p.eol_curve) {
+  // The viscous coefficient the residual rules use: 0 without the model or an end-of-line curve.
+  if (!p.eol_viscous_model || !p.eol_curve) p.eol_viscous_kN_per_rev_per_s = 0.0;
+  if (p.eol_viscous_narrows_speed_allowance) {
     p.residual_speed_kN_per_rev_per_s = std::max(0.0, p.residual_speed_kN_per_rev_per_s - p.eol_viscous_kN_per_rev_per_s);
     p.eol_speed_kN_per_rev_per_s = std::max(0.0, p.eol_speed_kN_per_rev_per_s - p.eol_viscous_kN_per_rev_per_s);
   }

@@ -235,16 +235,16 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   const double creep_kN = eol_ ? creep_kN_ : 0.0;
   // So is the drive's viscous friction while the spindle moves (as the end-of-line test measured
   // it, on the motor's measured speed; 0 without, or while the motor crosses the play).
-  const double viscous_kN = eol_ && p.eol_viscous_model && p.eol_viscous_kN_per_rev_per_s > 0.0 && spindle_moved_ &&
-                                    std::isfinite(r.speed_rev_per_s)
-                                ? p.eol_viscous_kN_per_rev_per_s * r.speed_rev_per_s
-                                : 0.0;
-  const double lc_offset_kN = (eol_ && p.eol_thermal_offset_model
-                                   ? p.eol_load_cell_kN_per_C * (temperature_C - p.eol_load_cell_reference_C)
-                                   : 0.0) +
-                              viscous_kN;
+  // (FaultMonitor leaves the coefficient 0 without the model or an end-of-line curve.)
+  const double viscous_kN =
+      spindle_moved_ && std::isfinite(r.speed_rev_per_s) ? p.eol_viscous_kN_per_rev_per_s * r.speed_rev_per_s : 0.0;
+  // What the load cell reads beyond the clamp force and the keys' friction.
+  const double lc_extra_kN = (eol_ && p.eol_thermal_offset_model
+                                  ? p.eol_load_cell_kN_per_C * (temperature_C - p.eol_load_cell_reference_C)
+                                  : 0.0) +
+                             viscous_kN;
   auto clamp_kN = [&](double x_rev) { return std::max(0.0, eol_->force_kN(x_rev, temperature_C, 0.0) + creep_kN); };
-  auto pads_kN = [&](double x_rev) { return clamp_kN(x_rev) + lc_offset_kN; };
+  auto pads_kN = [&](double x_rev) { return clamp_kN(x_rev) + lc_extra_kN; };
   const double keys_clamp_kN = eol_ ? clamp_kN(x_keys_rev) : 0.0;
   // The clamp force's bounds for the tracking rules: the curve where the keys can be furthest in
   // and out (the motor's position +- half the play), with the curve's band, accuracy and speed.
@@ -255,7 +255,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     const double f_lo_kN = clamp_kN(r.position_rev - 0.5 * p.eol_backlash_rev);
     clamp_lower_kN_ = f_lo_kN - eol_allowance_kN(p, p.eol_band_kN, 0.0, f_lo_kN, r.speed_rev_per_s);
   }
-  const double eol_keys_kN = eol_ ? keys_clamp_kN + lc_offset_kN : e.curve_force_kN;
+  const double eol_keys_kN = eol_ ? keys_clamp_kN + lc_extra_kN : e.curve_force_kN;
   // Keys whose friction grows with the clamp force (as the end-of-line test measured it: the
   // plant's load-dependent friction, key friction x (1 + gain F / F_ref)): the friction model and
   // every band of its width scale with the force where the keys are.
@@ -307,7 +307,7 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // caliper, tuning seed 1403 run 124: -1.6 kN at no clamp force, never named).
   if (below && p.residual_low_lower_bound) {
     low_over = low_over ||
-               lc_offset_kN - r.force_kN > eol_allowance_kN(p, p.eol_band_kN, scaled_half_width_kN(p), 0.0, r.speed_rev_per_s);
+               lc_extra_kN - r.force_kN > eol_allowance_kN(p, p.eol_band_kN, scaled_half_width_kN(p), 0.0, r.speed_rev_per_s);
   }
   if (below && p.residual_low_static_span_rev > 0.0) {
     // The curve at the motor's position: the keys' position is the motor's until the friction

@@ -122,7 +122,7 @@ struct MonitorParams {
   bool eol_viscous_model = true;
   // ... and the residual rules' speed allowances, for speed effects no model carries, are narrowed
   // by the viscous term the model carries (FaultMonitor takes it out of residual_speed_kN_per_rev_per_s
-  // and eol_speed_kN_per_rev_per_s).
+  // and eol_speed_kN_per_rev_per_s, and sets the coefficient to 0 where the model is off).
   bool eol_viscous_narrows_speed_allowance = true;
   double eol_viscous_kN_per_rev_per_s = 0.0;
   double eol_load_cell_kN_per_C = 0.0;
