@@ -27,6 +27,9 @@ using Clock = std::chrono::steady_clock;
 
 // Older than this, a command is stale in a hot-standby run (ten CCU periods).
 constexpr auto kStaleCommand = std::chrono::milliseconds(50);
+// A hot-standby run, realtime: a period begun this late is one of the corner's own stalls in its
+// failover stats (the commands' deadline, as a CCU's own stalls are counted).
+constexpr double kOwnStallRecorded_s = 0.010;
 
 node::CornerNodeOptions node_options(const CornerOptions& o) {
   node::CornerNodeOptions n;
@@ -225,6 +228,8 @@ void CornerApp::write_failover_stats() const {
   runtime::CornerFailoverStats s = owners_.stats();
   s.corner = dds::corner_name(options_.corner);
   s.commands_stale = stale_commands_;
+  s.stalls = own_stalls_.stalls;
+  s.stall_intervals = own_stalls_.stall_intervals;
   runtime::save(s, file + "_failover.stats");
 }
 
@@ -306,6 +311,12 @@ int CornerApp::run(std::string& error) {
         jitter_sum_s_ += late_s;
         if (late_s > stats.max_jitter_s) stats.max_jitter_s = late_s;
         if (late_s > scenario_.ccu_period_s) ++stats.overruns;
+        // Not running, this corner could take no command: not the CCU's silence (its watchdog).
+        if (late_s > 0.0) {
+          const double now_s = sim_now_s();
+          node_.on_own_stall(now_s - late_s, now_s);
+        }
+        if (options_.standby && late_s >= kOwnStallRecorded_s) runtime::note_corner_stall(own_stalls_, late_s, runtime::mono_now_s());
       }
       if (node_.latest_command().stop()) break;
       if (lockstep && !node_.granted(k)) node_.set_ccu_lost();  // only ccu_gone() ends the wait without a grant

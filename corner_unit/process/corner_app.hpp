@@ -137,6 +137,7 @@ class CornerApp {
   bool have_role_ = false;
   std::array<transport::EndpointId, 2> calibration_writer_{};  // the CCUs heard on CalibrationState
   std::size_t calibration_writers_ = 0;
+  runtime::CornerFailoverStats own_stalls_;  // realtime standby run: only its stalls fields are used
   std::uint64_t stale_commands_ = 0;  // realtime standby run: commands dropped as written too long ago
   // Lockstep on the receiving thread: the next period to simulate, and the first.
   std::uint64_t next_k_ = 0;

@@ -1,5 +1,6 @@
 #include "bbw/runtime/failover_stats.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -47,6 +48,7 @@ void corner_fields(S& s, F&& f) {
   f("max_gap_sim_ms", s.max_gap_sim_ms);
   f("max_gap_sim_at_s", s.max_gap_sim_at_s);
   f("last_command_mono_s", s.last_command_mono_s);
+  f("stalls", s.stalls);
 }
 
 std::string format(double v) {
@@ -134,21 +136,57 @@ std::string read_file(const std::string& file) {
 
 }  // namespace
 
-std::string to_text(const CcuFailoverStats& s) {
-  Writer w;
-  ccu_fields(s, w);
+void note_corner_stall(CornerFailoverStats& s, double late_s, double now_mono_s) {
+  const StallInterval x{now_mono_s - late_s, now_mono_s};
+  if (!s.stall_intervals.empty() && s.stall_intervals.back().to_mono_s >= x.from_mono_s) {
+    s.stall_intervals.back().to_mono_s = std::max(s.stall_intervals.back().to_mono_s, x.to_mono_s);
+    return;
+  }
+  ++s.stalls;
+  if (s.stall_intervals.size() < CcuFailoverStats::kMaxStallIntervals) s.stall_intervals.push_back(x);  // else counted only
+}
+
+namespace {
+
+template <class S, class W>
+void write_stalls(const S& s, W& w) {
   w("stall_intervals", static_cast<std::uint64_t>(s.stall_intervals.size()));
   for (std::size_t i = 0; i < s.stall_intervals.size(); ++i) {
     const std::string p = "stall" + std::to_string(i) + ".";
     w((p + "from_mono_s").c_str(), s.stall_intervals[i].from_mono_s);
     w((p + "to_mono_s").c_str(), s.stall_intervals[i].to_mono_s);
   }
+}
+
+template <class S, class R>
+void read_stalls(S& s, R& r) {
+  std::uint64_t n = 0;
+  r("stall_intervals", n);
+  if (n > CcuFailoverStats::kMaxStallIntervals || n > s.stalls) {
+    r.bad("stall_intervals", std::to_string(n), "at most 64 and at most `stalls`");
+  }
+  for (std::uint64_t i = 0; i < n; ++i) {
+    const std::string p = "stall" + std::to_string(i) + ".";
+    StallInterval x;
+    r((p + "from_mono_s").c_str(), x.from_mono_s);
+    r((p + "to_mono_s").c_str(), x.to_mono_s);
+    s.stall_intervals.push_back(x);
+  }
+}
+
+}  // namespace
+
+std::string to_text(const CcuFailoverStats& s) {
+  Writer w;
+  ccu_fields(s, w);
+  write_stalls(s, w);
   return w.str();
 }
 
 std::string to_text(const CornerFailoverStats& s) {
   Writer w;
   corner_fields(s, w);
+  write_stalls(s, w);
   w("switches", static_cast<std::uint64_t>(s.switches.size()));
   w("switches_dropped", s.switches_dropped);
   for (std::size_t i = 0; i < s.switches.size(); ++i) {
@@ -170,18 +208,7 @@ CcuFailoverStats parse_ccu_failover(const std::string& text, const std::string& 
   Reader r(m, file);
   ccu_fields(s, r);
   if (s.role != "primary" && s.role != "standby") r.bad("role", s.role, "primary or standby");
-  std::uint64_t n = 0;
-  r("stall_intervals", n);
-  if (n > CcuFailoverStats::kMaxStallIntervals || n > s.stalls) {
-    r.bad("stall_intervals", std::to_string(n), "at most 64 and at most `stalls`");
-  }
-  for (std::uint64_t i = 0; i < n; ++i) {
-    const std::string p = "stall" + std::to_string(i) + ".";
-    StallInterval x;
-    r((p + "from_mono_s").c_str(), x.from_mono_s);
-    r((p + "to_mono_s").c_str(), x.to_mono_s);
-    s.stall_intervals.push_back(x);
-  }
+  read_stalls(s, r);
   return s;
 }
 
@@ -190,6 +217,7 @@ CornerFailoverStats parse_corner_failover(const std::string& text, const std::st
   CornerFailoverStats s;
   Reader r(m, file);
   corner_fields(s, r);
+  read_stalls(s, r);
   std::uint64_t n = 0;
   r("switches", n);
   r("switches_dropped", s.switches_dropped);

@@ -24,6 +24,10 @@
 //                [--duration-s S] [--force-kN F] [--dds-profiles FILE.xml]
 //                [--measurements flood|hostile [--rate-x N]] [--run-id HEX]
 //
+// --ready-file PATH: created (whole, by a rename) once the attempt is under way: its first command
+// to every corner written, or its participant or writer refused. A test waits for it before it
+// lets a run end, so that "never commanded a corner" was tried during the run.
+//
 // --run-id HEX: an intruder that knows a run's id (unsecured, anyone on the domain can read
 // the partitions in discovery) writes in that run's partitions and stamps that id on every
 // message (issue 17); without it, commands go partition-less and measurements to corner_<C>,
@@ -61,7 +65,7 @@ using BlockT = bbw::msg::MeasurementBlockPubSubType;
 constexpr const char* kUsage =
     "usage: bbw_intruder --as none|rogue|corner [--keys DIR] [--corner FL|FR|RL|RR] [--domain N]\n"
     "                    [--duration-s S] [--force-kN F] [--dds-profiles FILE.xml] [--run-id HEX [--stamp-run-id HEX]]\n"
-    "                    [--measurements flood|hostile [--rate-x N]]\n";
+    "                    [--ready-file PATH] [--measurements flood|hostile [--rate-x N]]\n";
 
 struct Options {
   std::string as;
@@ -73,6 +77,7 @@ struct Options {
   std::string profiles_file;
   std::string measurements;  // "", flood, hostile
   int rate_x = 20;
+  std::string ready_file;    // created once the attempt is under way ("": none)
   std::optional<std::uint64_t> run_id;  // --run-id: write in that run's partitions, with its id
   std::optional<std::uint64_t> stamp;   // --stamp-run-id: the id written in the messages instead
   std::uint64_t stamped() const { return stamp.value_or(run_id.value_or(0)); }
@@ -172,6 +177,7 @@ Options parse(int argc, char** argv) {
     else if (k == "--duration-s") o.duration_s = parse_positive(next(), "--duration-s");
     else if (k == "--force-kN") o.force_kN = parse_positive(next(), "--force-kN");
     else if (k == "--dds-profiles") o.profiles_file = next();
+    else if (k == "--ready-file") o.ready_file = next();
     else if (k == "--run-id") {
       const std::string v = next();
       o.run_id = bbw::dds::parse_run_id(v);
@@ -220,6 +226,18 @@ bbw::dds::ParticipantOptions participant_options(const Options& o) {
   return p;
 }
 
+// --ready-file: written whole (a temporary file renamed), once. False when it cannot be written.
+bool mark_ready(const std::string& file, bool& done) {
+  if (file.empty() || done) return true;
+  done = true;
+  const std::string tmp = file + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "w");
+  const bool ok = f != nullptr && std::fputs("under way\n", f) >= 0 && std::fclose(f) == 0 &&
+                  std::rename(tmp.c_str(), file.c_str()) == 0;
+  if (!ok) std::fprintf(stderr, "bbw_intruder: --ready-file %s: cannot write it\n", file.c_str());
+  return ok;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -240,6 +258,8 @@ int main(int argc, char** argv) {
   std::uint64_t written = 0;
   BlockCounts blocks;
   std::string refused;
+  bool ready_done = false, ready_ok = true;
+  auto ready = [&] { ready_ok = mark_ready(o.ready_file, ready_done) && ready_ok; };
   try {
     bbw::dds::Participant participant(participant_options(o));
     participant_ok = true;
@@ -258,6 +278,7 @@ int main(int argc, char** argv) {
         writer_ok = true;
       } catch (const bbw::dds::DdsError& e) {
         refused = e.what();
+        ready();  // refused: the attempt is decided
       }
       if (bw) {
         const auto end = std::chrono::steady_clock::now() +
@@ -265,6 +286,7 @@ int main(int argc, char** argv) {
                              std::chrono::duration<double>(o.duration_s));
         // Write only once a reader listens (the CCU), within the duration.
         bw->wait_for_matched(1, end - std::chrono::steady_clock::now());
+        ready();
         blocks = write_blocks(*bw, events, o, static_cast<std::uint8_t>(corner_id), end);
         max_matched = blocks.max_matched;
         written = blocks.blocks;
@@ -281,6 +303,7 @@ int main(int argc, char** argv) {
     } catch (const bbw::dds::DdsError& e) {
       refused = e.what();
       writers.clear();
+      ready();  // refused: the attempt is decided
     }
     if (!writers.empty()) {
       // One command per corner every 5 ms until the deadline; waits are timed condition waits.
@@ -304,6 +327,7 @@ int main(int argc, char** argv) {
         int matched = 0;  // readers reached over all writers (one corner each with --run-id)
         for (const auto& w : writers) matched += w->matched();
         max_matched = std::max(max_matched, matched);
+        ready();  // every corner's first command written
         tick += std::chrono::milliseconds(5);
         events.wait_until(std::min(tick, end), [] { return false; });
       }
@@ -311,6 +335,7 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     if (!participant_ok) {
       refused = e.what();
+      ready();  // refused: the attempt is decided
     } else {
       std::cerr << "bbw_intruder: " << e.what() << "\n";
       return 1;
@@ -326,5 +351,5 @@ int main(int argc, char** argv) {
   }
   std::printf("}\n");
   if (!refused.empty()) std::fprintf(stderr, "bbw_intruder: refused: %s\n", refused.c_str());
-  return 0;
+  return ready_ok ? 0 : 1;
 }

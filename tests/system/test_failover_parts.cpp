@@ -91,7 +91,16 @@ TEST(FailoverStats, RoundTripAndNameWhatIsWrong) {
   k.corner = "FL";
   k.switches.push_back({"none", "primary", 0, 0.0, 10.0, 0.0});
   k.switches.push_back({"primary", "standby", 700, 3.5, 13.5, 15.0});
+  // A corner's own stall: its late periods, caught up one after another, merge into one.
+  runtime::note_corner_stall(k, 0.060, 20.060);
+  runtime::note_corner_stall(k, 0.055, 20.0601);
+  runtime::note_corner_stall(k, 0.012, 30.0);
+  ASSERT_EQ(k.stalls, 2u);
+  EXPECT_DOUBLE_EQ(k.stall_intervals[0].from_mono_s, 20.0);
+  EXPECT_DOUBLE_EQ(k.stall_intervals[0].to_mono_s, 20.0601);
   const auto kb = runtime::parse_corner_failover(runtime::to_text(k), "y.stats");
+  ASSERT_EQ(kb.stall_intervals.size(), 2u);
+  EXPECT_DOUBLE_EQ(kb.stall_intervals[1].from_mono_s, 29.988);
   ASSERT_EQ(kb.switches.size(), 2u);
   EXPECT_EQ(kb.switches[1].to, "standby");
   EXPECT_DOUBLE_EQ(kb.switches[1].gap_ms, 15.0);

@@ -131,11 +131,15 @@ class Intruder {
   // niced: at the lowest CPU priority (nice 19), for a flooder that stands for another ECU.
   Intruder(const std::string& dir, const std::string& name, std::vector<std::string> args, bool niced = false)
       : dir_(dir), name_(name) {
+    fs::remove(ready_file());
+    args.insert(args.end(), {"--ready-file", ready_file()});
     args.insert(args.begin(), bin("bbw_intruder"));
     if (niced) args.insert(args.begin(), {"/usr/bin/nice", "-n", "19"});
     child_ = std::make_unique<bbw::runtime::Child>(name, args, dir + "/" + name + ".stdout", dir + "/" + name + ".stderr");
   }
   bool running() { return !child_->poll().has_value(); }
+  // Its attempt is under way: a first command to every corner written, or it was refused.
+  bool ready() const { return fs::exists(ready_file()); }
   // Stops it (SIGTERM ends its attempt) and waits (bounded) for the end; its exit status.
   bbw::runtime::ExitStatus stop(std::chrono::seconds limit) {
     if (running()) child_->send_signal(SIGTERM);
@@ -151,6 +155,7 @@ class Intruder {
   }
 
  private:
+  std::string ready_file() const { return dir_ + "/" + name_ + ".ready"; }
   std::string dir_, name_;
   std::unique_ptr<bbw::runtime::Child> child_;
 };
@@ -232,33 +237,59 @@ TEST(SystemSecure, IntrudersNeverCommandACornerOfASecureRun) {
   // They join once the run is under way (the CCU logs samples): joining while the five secure
   // participants still shake hands made Fast DDS 2.9's handshake race (below) leave three
   // corners unauthenticated for the whole 20 s discovery deadline (1 of 2 full-suite runs).
-  auto l = start_launch(dir, 223, "lockstep", true);
-  const std::string run_id = l->run_id();
-  ASSERT_EQ(run_id.size(), 16u) << l->out() << l->err();
-  const auto underway = Clock::now() + 60s;
-  while (Clock::now() < underway && lines_in(dir + "/out/ccu_FL.csv") < 50 && !l->ended_within(20ms)) {
+  // The intruders must be writing before the run ends, or the test proves nothing: a clean-clone
+  // CI run's rogue intruder had written nothing when the 3 s lockstep run ended. A run that ended
+  // before all three were under way (each says so in its --ready-file) is not judged and is run
+  // again, at most three times.
+  for (int attempt = 1;; ++attempt) {
+    fs::remove_all(dir + "/out");
+    auto l = start_launch(dir, 223, "lockstep", true);
+    const std::string run_id = l->run_id();
+    ASSERT_EQ(run_id.size(), 16u) << l->out() << l->err();
+    const auto underway = Clock::now() + 60s;
+    while (Clock::now() < underway && lines_in(dir + "/out/ccu_FL.csv") < 50 && !l->ended_within(20ms)) {
+    }
+    ASSERT_GE(lines_in(dir + "/out/ccu_FL.csv"), 50u) << "the run never got under way\n" << l->out() << l->err();
+    Intruder none(dir, "intruder_none", args({"--as", "none", "--run-id", run_id}));
+    Intruder rogue(dir, "intruder_rogue", args({"--as", "rogue", "--run-id", run_id}));
+    Intruder corner(dir, "intruder_corner", args({"--as", "corner", "--corner", "FL", "--run-id", run_id}));
+    bool run_ended = false;
+    const auto ready_by = Clock::now() + 60s;
+    while (Clock::now() < ready_by && !(none.ready() && rogue.ready() && corner.ready())) {
+      if (l->ended_within(20ms)) {
+        run_ended = true;
+        break;
+      }
+    }
+    const bool all_ready = none.ready() && rogue.ready() && corner.ready();
+    const ProcessRun r = finish_launch(*l);
+    if (!all_ready && attempt < 3) {
+      std::cout << "[ NOTE     ] attempt " << attempt << ": the run " << (run_ended ? "ended" : "went on for 60 s")
+                << " before every intruder was under way (none " << none.ready() << ", rogue " << rogue.ready()
+                << ", corner " << corner.ready() << "); running it again" << std::endl;
+      none.stop(20s), rogue.stop(20s), corner.stop(20s);
+      continue;
+    }
+    EXPECT_TRUE(all_ready) << "the intruders were not under way before the run ended (none " << none.ready() << ", rogue "
+                           << rogue.ready() << ", corner " << corner.ready() << ")";
+    // The intruders were there until the end of the run.
+    EXPECT_TRUE(none.running() && rogue.running()) << "the run outlasted the intruders: make --duration-s longer";
+    ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
+    expect_clean_lockstep_run(dir + "/out");
+    for (const char* c : kCorners) {
+      EXPECT_EQ(periods_with_intruder_force(dir + "/out", c), 0u) << "corner " << c << " applied the intruder's force";
+    }
+    const std::string jn = none.finish(20s), jr = rogue.finish(20s), jc = corner.finish(20s);
+    for (const std::string* j : {&jn, &jr}) {
+      EXPECT_TRUE(json_true(*j, "participant") && json_true(*j, "writer")) << *j;
+      EXPECT_GE(json_number(*j, "written"), 4.0) << *j;  // at least one command to every corner, during the run
+      EXPECT_EQ(json_number(*j, "max_matched"), 0.0) << *j;
+    }
+    EXPECT_TRUE(json_true(jc, "participant")) << jc;
+    EXPECT_FALSE(json_true(jc, "writer")) << "access control let corner FL write commands: " << jc;
+    EXPECT_EQ(json_number(jc, "max_matched"), 0.0) << jc;
+    break;
   }
-  ASSERT_GE(lines_in(dir + "/out/ccu_FL.csv"), 50u) << "the run never got under way\n" << l->out() << l->err();
-  Intruder none(dir, "intruder_none", args({"--as", "none", "--run-id", run_id}));
-  Intruder rogue(dir, "intruder_rogue", args({"--as", "rogue", "--run-id", run_id}));
-  Intruder corner(dir, "intruder_corner", args({"--as", "corner", "--corner", "FL", "--run-id", run_id}));
-  const ProcessRun r = finish_launch(*l);
-  // The intruders were there until the end of the run.
-  EXPECT_TRUE(none.running() && rogue.running()) << "the run outlasted the intruders: make --duration-s longer";
-  ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.out << r.err;
-  expect_clean_lockstep_run(dir + "/out");
-  for (const char* c : kCorners) {
-    EXPECT_EQ(periods_with_intruder_force(dir + "/out", c), 0u) << "corner " << c << " applied the intruder's force";
-  }
-  const std::string jn = none.finish(20s), jr = rogue.finish(20s), jc = corner.finish(20s);
-  for (const std::string* j : {&jn, &jr}) {
-    EXPECT_TRUE(json_true(*j, "participant") && json_true(*j, "writer")) << *j;
-    EXPECT_GT(json_number(*j, "written"), 400.0) << *j;
-    EXPECT_EQ(json_number(*j, "max_matched"), 0.0) << *j;
-  }
-  EXPECT_TRUE(json_true(jc, "participant")) << jc;
-  EXPECT_FALSE(json_true(jc, "writer")) << "access control let corner FL write commands: " << jc;
-  EXPECT_EQ(json_number(jc, "max_matched"), 0.0) << jc;
   fs::remove_all(dir);
 }
 

@@ -40,11 +40,20 @@ void CcuWatchdog::on_command(double time_s, double force_command_kN) {
   have_command_ = true;
   last_command_s_ = time_s;
   last_force_kN_ = force_command_kN;
+  own_stall_s_ = 0.0;
+}
+
+void CcuWatchdog::on_own_stall(double from_s, double to_s) {
+  if (!p_.exclude_own_stalls || !have_command_ || !std::isfinite(from_s) || !std::isfinite(to_s)) return;
+  const double from = std::max({from_s, last_command_s_, stall_counted_to_s_});
+  if (to_s <= from) return;
+  own_stall_s_ += to_s - from;
+  stall_counted_to_s_ = to_s;
 }
 
 WatchdogOutput CcuWatchdog::at(double time_s) const {
   if (!have_command_) return {};
-  const double silent_s = time_s - last_command_s_;
+  const double silent_s = time_s - last_command_s_ - own_stall_s_;
   if (silent_s < p_.timeout_s) return {WatchdogMode::Normal, last_force_kN_};
   const double default_from_s = p_.timeout_s + p_.hold_s;
   if (silent_s < default_from_s) return {WatchdogMode::Holding, last_force_kN_};

@@ -117,6 +117,9 @@ class CornerNode {
   // rated force range and rate; issue 17): `source` says who sent it.
   void on_command(const msg::ClampCommand& command, const corner::CommandSource& source, double arrival_s);
   void on_calibration(const msg::CalibrationState& state);
+  // Realtime: this corner did not run from from_s to to_s (a period begun late; the same clock
+  // as arrival_s). The watchdog does not count it as the CCU's silence (CcuWatchdog::on_own_stall).
+  void on_own_stall(double from_s, double to_s) { watchdog_.on_own_stall(from_s, to_s); }
   // A vehicle run (issue 15): the caliper's temperature as the vehicle computes it from the brake
   // disc, applied from the next period on; NaN (the default) keeps the scenario's conditions.
   void set_caliper_temperature_C(double temperature_C) { caliper_temperature_C_ = temperature_C; }

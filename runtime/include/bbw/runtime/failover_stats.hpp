@@ -64,10 +64,18 @@ struct CornerFailoverStats {
   double max_gap_sim_ms = 0.0;
   double max_gap_sim_at_s = -1.0;
   double last_command_mono_s = -1.0;
+  // Realtime: the corner's own stalls (a period begun later than the command deadline), merged
+  // where the late periods of one stall overlap; the first kMaxStallIntervals kept, all counted.
+  std::uint32_t stalls = 0;
+  std::vector<StallInterval> stall_intervals;
   std::vector<OwnerSwitch> switches;    // in order; the first is none -> the first owner
   // Changes not kept, all between switches[CommandOwnerTracker::kKeepFirst - 1] and the next.
   std::uint64_t switches_dropped = 0;
 };
+
+// A corner's period began late_s late at now_mono_s: a stall from now - late to now, merged into
+// the last one where they overlap (a stall's late periods are caught up one after another).
+void note_corner_stall(CornerFailoverStats& s, double late_s, double now_mono_s);
 
 std::string to_text(const CcuFailoverStats& s);
 std::string to_text(const CornerFailoverStats& s);
