@@ -174,6 +174,31 @@ TEST(CampaignDraw, EveryDrawLoadsAsAFaultScenarioWithinTheSpec) {
   EXPECT_GT(intermittent, 10);
 }
 
+// Every profile's demand, as written to the run's scenario (times to 0.1 ms), has strictly
+// increasing times. The cut at the run's end interpolated a point there even when the point
+// before it lay within 0.1 ms of it, and both were written as the same time: an ad hoc hunt
+// (seed 2903, the spec below) lost run 12 to "times must increase strictly".
+TEST(CampaignDraw, EveryProfilesDemandLoadsEvenWhereItsCutFallsOnAPoint) {
+  std::string text =
+      "name: hunt\nseed: 2903\nruns: 200\nfault_free_share: 1.0\nduration_s: [16, 24]\n"
+      "population: {spec: POP, members: 60}\ntemperatures_C: [15, 90]\neffects_share: 0.6\n"
+      "effects: [viscous_friction, sensor_delay, backlash, load_dependent_friction, creep, thermal_drift]\n"
+      "profiles: [city, abs, slow_ramps, long_hold, hard_stop_start, hard_stop_release]\n"
+      "faults:\n  kinds: [bias, drift, load_cell_stuck, noise_burst, dropout, resolver_offset, resolver_stuck,\n"
+      "          torque_loss, total_loss, seized, silence, delay]\n  onsets: [before_first_fit, hard_stop, normal]\n"
+      "  two_faults_share: 0.3\n  same_corner_share: 0.5\n  intermittent_share: 0.3\n";
+  text.replace(text.find("POP"), 3, src("config/population/extreme.yaml"));
+  const CampaignSpec s = load_campaign_spec_string(text, "hunt.yaml");
+  const std::string plant = src("config/plant/ecaliper.yaml");
+  const RunPlan r12 = draw_run(s, 12);
+  ASSERT_NO_THROW(faults::load_fault_scenario_string(scenario_yaml(s, r12, plant), "run12.yaml"));
+  for (int i = 0; i < s.runs; ++i) {
+    const RunPlan r = draw_run(s, i);
+    const std::string yaml = scenario_yaml(s, r, plant);
+    ASSERT_NO_THROW(faults::load_fault_scenario_string(yaml, "run.yaml")) << "run " << i << "\n" << yaml;
+  }
+}
+
 // Above the detectability limit: by magnitude; a drift also by the offset it reaches (a bias's
 // limit, 1 kN), so an intermittent drift that ends first is below it, whatever its rate.
 TEST(CampaignDraw, ADriftIsAboveItsLimitOnlyOnceItsOffsetReachesTheBiasLimit) {
