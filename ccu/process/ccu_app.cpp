@@ -254,6 +254,24 @@ void CcuApp::demote(double sim_s, const char* reason) {
             << " at " << sim_s << " s (" << reason << ")" << std::endl;
 }
 
+// Cut off: the commands written since the link went down wait in the writers' reliable histories
+// and would be delivered when it returns, stale. The corners drop them, but DDS ownership would
+// already have passed to this writer, whose lowered strength may not have reached them yet, and
+// the other CCU's commands would not be let through until this writer missed its deadline (a
+// -j2 system pass: 25 ms without a command and the corners' safe state, just after the link
+// returned, with the standby never stalled). So they are discarded here.
+void CcuApp::discard_unsent_commands() {
+  for (auto& c : commands_) {
+    std::size_t removed = 0;
+    if (c->get().get().clear_history(&removed) != ReturnCode_t::RETCODE_OK) {
+      throw dds::DdsError("cannot clear the command writer's history after a cut");
+    }
+    commands_discarded_ += removed;
+  }
+  std::cout << "bbw_ccu (" << options_.role << "): discarded " << commands_discarded_
+            << " commands unsent since the cut (they would arrive stale)" << std::endl;
+}
+
 // The link is back after a cut: quiet for kRejoinQuiet, and the lowered strength announced again
 // (set while cut off, its discovery message may not have reached the corners: once they kept the
 // returned primary as the owner for the rest of the run). A strength 1 lower is a new value, so
@@ -571,6 +589,7 @@ int CcuApp::run(std::string& error) {
         if (last_block_at_ != Clock::time_point{} && quiet_s > kCutOff_s && ran_on_time && k + 4 < periods_ && !cut_off_) {
           demote(t_k, "cut off from every corner");
           cut_off_ = true;  // one outage until a block arrives again
+          discard_unsent_commands();
         }
         // The gap to the next send starts now: the demotion's own time (set_qos) is not a stall.
         last_send_ = Clock::now();

@@ -87,6 +87,7 @@ class CcuApp {
   // An outage (stopped and continued, cut off): lowers this CCU's command strength
   // (dds::ccu_strength; docs/faults.md "Hand-back").
   void demote(double sim_s, const char* reason);
+  void discard_unsent_commands();  // cut off: the commands waiting in the writers' histories
   std::uint32_t strength() const;
   void set_strength(std::uint32_t strength);
   void link_back();
@@ -115,6 +116,7 @@ class CcuApp {
   std::vector<eprosima::fastrtps::rtps::InstanceHandle_t> instances_;  // each corner's key instance
   using CommandOutlet = dds::DdsOutlet<msg::ClampCommandPubSubType>;
   std::vector<std::unique_ptr<CommandOutlet>> commands_;  // one per corner, in its partition
+  std::uint64_t commands_discarded_ = 0;  // realtime standby run: unsent when it found itself cut off
   dds::DdsOutlet<msg::CalibrationStatePubSubType> calibration_;
 
   msg::MeasurementBlock block_;
