@@ -20,6 +20,11 @@ const Diagnosis& actuator(const LoopResult& r, std::size_t corner) {
   return r.diagnoses[corner * 5 + static_cast<std::size_t>(Part::Actuator)];
 }
 
+// ... and its load cell's.
+const Diagnosis& load_cell(const LoopResult& r, std::size_t corner) {
+  return r.diagnoses[corner * 5 + static_cast<std::size_t>(Part::LoadCell)];
+}
+
 // The campaign scenarios hold a stop from 10 s to 13 s and inject at 11 s.
 constexpr double kFaultAt = 11.0;
 constexpr double kStopEnd = 13.0;
@@ -857,6 +862,44 @@ TEST(ClosedLoopIssue14, AHoldRestartsAfterTheDriveLeftTheTrustedRange) {
   expect_quiet_only_with_the_rule("config/scenarios/faults/fault_free_slow_reversal_below_the_trusted_range.yaml",
                                   "the hold restarted below the trusted range", Finding::LoadCellOffset,
                                   [](MonitorParams& m) { m.hold_restart_untrusted = false; });
+}
+
+// A caliper ten times softer than the shipped one travels beyond 10 rev in hard stops (soft10_ff
+// run 126). With the guard's shipped 10 rev, its samples up there are rejected and its drive turns
+// round unseen; back below, a gap of unseen positions forgets the end-of-line friction model's and
+// the calibrator's friction states (residual.unseen_gap_forgets); kept, their way-up state named
+// load_cell_offset at 13.87 s.
+TEST(ClosedLoopIssue14, AGapOfUnseenPositionsForgetsTheKeysState) {
+  const auto fs = load("config/scenarios/faults/fault_free_soft_caliper_back_from_beyond_the_guard.yaml");
+  auto opts = default_options();
+  opts.monitor.guard_position_from_eol = false;  // the gap: samples beyond 10 rev rejected
+  const auto r = run_closed_loop(fs, opts);
+  const std::size_t fl = 0;
+  EXPECT_GT(r.guard_rejected[fl], 100u);
+  EXPECT_EQ(r.faults_raised(), 0u);
+  opts.monitor.residual_unseen_gap_forgets = false;
+  const auto base = run_closed_loop(fs, opts);
+  EXPECT_EQ(load_cell(base, fl).finding, Finding::LoadCellOffset) << to_string(load_cell(base, fl).finding);
+  std::printf("FL beyond the guard (%llu samples rejected): %zu findings forgetting, %zu keeping (%s)\n",
+              static_cast<unsigned long long>(r.guard_rejected[fl]), r.faults_raised(), base.faults_raised(),
+              to_string(load_cell(base, fl).finding));
+}
+
+// The same caliper's guard takes positions up to where its end-of-line curve reaches the load
+// cell's range (guard.position_from_end_of_line): none of its samples is corrupt, and nothing is
+// raised. With the shipped 10 rev alone, hundreds of healthy samples are counted corrupt.
+TEST(ClosedLoopIssue14, ASoftCalipersTravelBeyondTenRevIsNotCorrupt) {
+  const auto fs = load("config/scenarios/faults/fault_free_soft_caliper_back_from_beyond_the_guard.yaml");
+  const auto r = run_closed_loop(fs, default_options());
+  const std::size_t fl = 0;
+  EXPECT_EQ(r.guard_rejected[fl], 0u);
+  EXPECT_EQ(r.faults_raised(), 0u);
+  auto opts = default_options();
+  opts.monitor.guard_position_from_eol = false;
+  const auto base = run_closed_loop(fs, opts);
+  EXPECT_GT(base.guard_rejected[fl], 100u);
+  std::printf("FL's samples rejected: %llu with the end-of-line range, %llu with 10 rev\n",
+              static_cast<unsigned long long>(r.guard_rejected[fl]), static_cast<unsigned long long>(base.guard_rejected[fl]));
 }
 
 // A healthy 0.08 kN load cell that goes below the trusted range after a hard stop's release

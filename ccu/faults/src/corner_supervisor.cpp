@@ -32,6 +32,15 @@ MonitorParams for_calibrator(MonitorParams p, const calibration::CalibratorConfi
   return p;
 }
 
+// The calibrator beside this guard: it accepts every position the guard does (a sample the guard
+// passes and the calibrator refuses leaves its friction states behind; see guard_position_from_eol).
+// (Only where the guard's range was widened: a calibrator configured narrower keeps its range.)
+calibration::CalibratorConfig accepting(calibration::CalibratorConfig c, const MonitorParams& m) {
+  const double guard_max_rev = guard_for_corner(m).position_max_rev;
+  if (guard_max_rev > m.guard.position_max_rev) c.accept_position_max_rev = std::max(c.accept_position_max_rev, guard_max_rev);
+  return c;
+}
+
 }  // namespace
 
 const char* to_string(EstimateSource s) {
@@ -46,10 +55,10 @@ const char* to_string(EstimateSource s) {
 
 CornerSupervisor::CornerSupervisor(const calibration::CalibratorConfig& calibrator, const MonitorParams& monitor,
                                    Target corner)
-    : config_(calibrator),
+    : config_(accepting(calibrator, monitor)),
       corner_(corner),
-      guard_(monitor.guard),
-      calibrator_(std::in_place, calibrator),
+      guard_(guard_for_corner(monitor)),
+      calibrator_(std::in_place, config_),
       monitor_(for_calibrator(monitor, calibrator), corner),
       last_good_(*calibrator_),
       trusted_curve_(calibrator.initial_curve) {
@@ -120,6 +129,12 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
   const bool was_lost = !monitor_.ok(Part::Network) || !monitor_.ok(Part::Process);
   if (was_lost) guard_.rejoin();
   const SampleCheck check = guard_.check(r);
+  // Usable again after samples the guard rejected (a position beyond its range): the positions
+  // between went unseen, so the calibrator's friction states and its cycle did not survive the
+  // gap either; it restarts from the last good curve, as after a rejoin (its fused estimate,
+  // friction 2.4 kN the wrong way, named load_cell_offset on a soft caliper back from 11.7 rev).
+  // (A lost corner's return restarts it below, once.)
+  if (!was_lost && check.usable() && monitor_.unseen_gap_before(r)) restart_calibrator();
   calibration::Estimate e;
   const calibration::Estimate* fed = nullptr;
   const bool sensors_ok = monitor_.ok(Part::LoadCell) && monitor_.ok(Part::Resolver);

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "bbw/plant/clamp_curve.hpp"
+
 namespace bbw::faults {
 namespace {
 
@@ -243,6 +245,29 @@ MonitorParams for_corner(const MonitorParams& params) {
 
 }  // namespace
 
+GuardLimits guard_for_corner(const MonitorParams& p) {
+  GuardLimits g = p.guard;
+  if (!p.guard_position_from_eol || !p.eol_curve) return g;
+  const plant::ClampCurve curve(*p.eol_curve);
+  const double t_C = p.eol_curve->reference_temperature_C;
+  auto below = [&](double x_rev) { return curve.force_kN(x_rev, t_C, 0.0) < g.load_cell_max_kN; };
+  if (!below(g.position_max_rev)) return g;
+  // The curve rises with the position: doubled until it reaches the range (at most 1000 rev, a
+  // curve that never does), then bisected to 1e-6 rev.
+  constexpr double kMostRev = 1000.0;
+  double lo = g.position_max_rev, hi = std::max(2.0 * lo, lo + 1.0);
+  while (hi < kMostRev && below(hi)) {
+    lo = hi;
+    hi = std::min(kMostRev, 2.0 * hi);
+  }
+  while (hi - lo > 1e-6) {
+    const double mid = 0.5 * (lo + hi);
+    (below(mid) ? lo : hi) = mid;
+  }
+  g.position_max_rev = hi;
+  return g;
+}
+
 FaultMonitor::FaultMonitor(const MonitorParams& params, Target corner)
     : p_(for_corner(params)), corner_(corner), residual_(p_), torque_(p_), step_(p_), moving_step_(p_) {
   if (!corner_slot(corner)) throw std::invalid_argument("FaultMonitor: monitors a corner, not the CCU");
@@ -273,6 +298,10 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
     dropout_.on_rejoin();
   }
   if (!check.usable()) return;  // corrupt: counted by the guard, never used
+  // Usable again after samples the guard rejected (or that never came, within one incarnation):
+  // where the position went meanwhile is unknown, so is the keys' state (MonitorParams::
+  // residual_unseen_gap_forgets).
+  if (unseen_gap_before(r)) residual_.on_rejoin();
 
   const SampleContext c{r, check, have_prev_, prev_, prev_lc_present_, have_prev_ ? r.time_s - prev_.time_s : 0.0};
   dropout_.update(c, p_, arbiter_);

@@ -19,6 +19,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.guard.current_abs_max_A = g.number("current_abs_max_A", pos);
   p.guard.max_sequence_jump = g.number("max_sequence_jump", Range::at_least(1.0));
   p.guard.max_time_jump_s = g.number("max_time_jump_s", pos);
+  p.guard_position_from_eol = g.boolean("position_from_end_of_line");
   g.finish();
 
   auto res = r.map("residual");
@@ -84,6 +85,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.residual_low_static_span_rev = res.number("low_static_span_rev", config::Range::non_negative());
   p.curve_min_rev = res.number("curve_min_rev");
   p.curve_max_rev = res.number("curve_max_rev");
+  p.residual_unseen_gap_forgets = res.boolean("unseen_gap_forgets");
   p.residual_on_profile_corners = res.boolean("on_profile_corners");
   res.finish();
 

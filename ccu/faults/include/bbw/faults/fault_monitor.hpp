@@ -40,6 +40,12 @@ namespace bbw::faults {
 
 struct MonitorParams {
   GuardLimits guard;
+  // With an end-of-line curve, a corner's guard takes positions up to where that curve (at its
+  // reference temperature) reaches the load cell's range, guard.load_cell_max_kN, when that is
+  // beyond guard.position_max_rev, and so does its calibrator: a caliper ten times softer than
+  // the shipped one needs 11-12 rev for 16-20 kN, and the guard rejected every sample up there as
+  // corrupt (soft10 campaigns: faults in hard stops unseen, healthy samples counted as corrupt).
+  bool guard_position_from_eol = true;
 
   // Analytic redundancy: r = (load cell - friction estimate) - curve(position).
   double residual_threshold_kN = 0.6;               // once the calibrator has an accepted fit
@@ -162,6 +168,12 @@ struct MonitorParams {
   // the change rule's reference does: its level and the positions it spanned hold only for the
   // samples it saw.
   bool hold_restart_untrusted = true;
+  // Usable samples more than jump_max_gap_s apart (those between rejected by the guard, e.g. a
+  // position beyond its range): the positions between went unseen, so the end-of-line friction
+  // model's state (the play's, the sweep's) is forgotten and the rules' references restart, as
+  // after a link outage. Without, a caliper that travelled beyond the guard's 10 rev and came back
+  // reversing judged its keys' reversal (2 x 4 kN) as a load-cell offset (soft10_ff).
+  bool residual_unseen_gap_forgets = true;
   // Revisit rule: where the drive has been before, the load cell against the end-of-line curve
   // and friction model keeps the level it had there (the curve and the friction are the same
   // there, a load-cell drift is not). Per position bin of revisit_bin_rev and class (moving up,
@@ -534,6 +546,10 @@ struct MonitorParams {
 
   void validate() const;  // throws std::invalid_argument naming the field, value and rule
 };
+// A corner's guard limits: MonitorParams::guard, its position range widened by
+// guard_position_from_eol.
+GuardLimits guard_for_corner(const MonitorParams& p);
+
 class FaultMonitor {
  public:
   FaultMonitor(const MonitorParams& params, Target corner);  // throws std::invalid_argument
@@ -558,6 +574,12 @@ class FaultMonitor {
   // Samples arrived again after a link or process loss; cleared by take_rejoin().
   bool rejoined() const { return link_.rejoined(); }
   bool take_rejoin() { return link_.take_rejoin(); }
+  // Whether a usable sample comes after an unseen gap (MonitorParams::residual_unseen_gap_forgets:
+  // more than jump_max_gap_s since the last usable one, within one incarnation): where the
+  // position went meanwhile is unknown, so is the keys' state. Asked before update() with it.
+  bool unseen_gap_before(const CornerReading& r) const {
+    return p_.residual_unseen_gap_forgets && have_prev_ && r.time_s - prev_.time_s > p_.jump_max_gap_s;
+  }
   // A dropout finding cleared (its values are back); true once per clearing.
   bool take_load_cell_cleared() { return dropout_.take_cleared(); }
   // A stuck-resolver finding cleared (the resolver lives again); true once per clearing.
