@@ -902,6 +902,16 @@ TEST(ClosedLoopIssue14, ASoftCalipersTravelBeyondTenRevIsNotCorrupt) {
               static_cast<unsigned long long>(r.guard_rejected[fl]), static_cast<unsigned long long>(base.guard_rejected[fl]));
 }
 
+// A hold's reference is set only from settle samples that lie within hold.settled_within_kN of
+// each other (soft10_ff run 2): FL's 5 ms load-cell lag after its wide keys reversed made the
+// residual fall 1.3 kN across the settle samples; their mean, taken as the hold's level, named
+// load_cell_offset at 2.305 s once the residual came to rest 0.85 kN below it.
+TEST(ClosedLoopIssue14, AHoldSettlesOnlyWhereTheResidualHasStoppedMoving) {
+  expect_quiet_only_with_the_rule("config/scenarios/faults/fault_free_soft_caliper_hold_after_delayed_key_reversal.yaml",
+                                  "the hold settled only on a level residual", Finding::LoadCellOffset,
+                                  [](MonitorParams& m) { m.hold_settled_within_kN = 0.0; });
+}
+
 // A healthy 0.08 kN load cell that goes below the trusted range after a hard stop's release
 // (extreme hunt seed 2613, run 478): its second differences' level, learnt afresh when they took
 // over from the residual's steps (noise.paths_restart_learning), is its own; learnt from one

@@ -42,6 +42,8 @@ void MonitorParams::validate() const {
   positive("hold_span_rev", hold_span_rev);
   positive("hold_span_known_rev", hold_span_known_rev);
   require(hold_settle_samples >= 1, "hold_settle_samples", hold_settle_samples, "must be >= 1");
+  require(std::isfinite(hold_settled_within_kN) && hold_settled_within_kN >= 0.0, "hold_settled_within_kN",
+          hold_settled_within_kN, "must be >= 0");
   positive("revisit_kN", revisit_kN);
   positive("revisit_bin_rev", revisit_bin_rev);
   require(revisit_settle_samples >= 1, "revisit_settle_samples", revisit_settle_samples, "must be >= 1");

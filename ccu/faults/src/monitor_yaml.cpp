@@ -57,6 +57,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.hold_span_rev = h.number("span_rev", pos);
     p.hold_span_known_rev = h.number("span_known_rev", pos);
     p.hold_settle_samples = static_cast<int>(h.integer("settle_samples", 1, 100000));
+    p.hold_settled_within_kN = h.number("settled_within_kN", config::Range::non_negative());
     p.hold_calibrated = h.boolean("calibrated");
     p.hold_rebase = h.boolean("rebase");
     p.hold_friction_as_moved = h.boolean("friction_as_moved");

@@ -510,6 +510,17 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     }
     ++hold_slow_;
     hold_sum_kN_ += residual_kN_;
+    hold_settle_min_kN_ = hold_slow_ == 1 ? residual_kN_ : std::min(hold_settle_min_kN_, residual_kN_);
+    hold_settle_max_kN_ = hold_slow_ == 1 ? residual_kN_ : std::max(hold_settle_max_kN_, residual_kN_);
+    if (hold_slow_ >= p.hold_settle_samples && p.hold_settled_within_kN > 0.0 &&
+        hold_settle_max_kN_ - hold_settle_min_kN_ > p.hold_settled_within_kN) {
+      // Not settled: again from this sample (its definition and positions as they are now).
+      hold_slow_ = 1;
+      hold_sum_kN_ = residual_kN_;
+      hold_settle_min_kN_ = hold_settle_max_kN_ = residual_kN_;
+      hold_x_min_rev_ = hold_x_max_rev_ = x_hold;
+      hold_scale0_ = friction_scale_;
+    }
     if (hold_slow_ >= p.hold_settle_samples) {
       hold_ref_ = true;
       hold_r0_kN_ = hold_sum_kN_ / hold_slow_;

@@ -188,6 +188,7 @@ class ResidualDetector {
   bool hold_known_ = false;  // the friction model's state was known when the reference was set
   int hold_slow_ = 0;
   double hold_sum_kN_ = 0.0;
+  double hold_settle_min_kN_ = 0.0, hold_settle_max_kN_ = 0.0;  // the settle samples' residuals
   double hold_r0_kN_ = 0.0;
   double hold_x0_rev_ = 0.0;
   double hold_f0_kN_ = 0.0;
