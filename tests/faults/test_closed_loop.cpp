@@ -912,6 +912,17 @@ TEST(ClosedLoopIssue14, AHoldSettlesOnlyWhereTheResidualHasStoppedMoving) {
                                   [](MonitorParams& m) { m.hold_settled_within_kN = 0.0; });
 }
 
+// On a caliper ten times stiffer with backlash (stiff10_ff run 1), before the play's state is known
+// the hold rule reads the curve at the motor's position: the force loop creeping the motor 0.015
+// rev inside the play at a constant 5.13 kN moved the residual by -0.77 kN (load_cell_offset at
+// 1.796 s). The hold's allowance adds the curve's change over the motor's motion, at most across
+// the play (hold.play_allowance).
+TEST(ClosedLoopIssue14, AMotorCreepingInsideThePlayIsNotALoadCellDrift) {
+  expect_quiet_only_with_the_rule("config/scenarios/faults/fault_free_stiff_caliper_motor_creeping_in_the_play.yaml",
+                                  "the hold's play allowance", Finding::LoadCellOffset,
+                                  [](MonitorParams& m) { m.hold_play_allowance = false; });
+}
+
 // A healthy 0.08 kN load cell that goes below the trusted range after a hard stop's release
 // (extreme hunt seed 2613, run 478): its second differences' level, learnt afresh when they took
 // over from the residual's steps (noise.paths_restart_learning), is its own; learnt from one

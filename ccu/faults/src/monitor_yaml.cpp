@@ -63,6 +63,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.hold_friction_as_moved = h.boolean("friction_as_moved");
     p.hold_friction_swing = h.boolean("friction_swing");
     p.hold_restart_untrusted = h.boolean("restart_untrusted");
+    p.hold_play_allowance = h.boolean("play_allowance");
     h.finish();
   }
   {

@@ -552,7 +552,13 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       friction_kN = friction_scale_ * friction_swing_kN(hold_x_max_rev_ - hold_x_min_rev_) +
                     std::abs(friction_scale_ - hold_scale0_) * eol_friction_half_width_kN_;
     }
-    const double hold_thr = eol_allowance_kN(p, p.hold_kN, friction_kN, hold_curve_kN - hold_f0_kN_, r.speed_rev_per_s);
+    double hold_thr = eol_allowance_kN(p, p.hold_kN, friction_kN, hold_curve_kN - hold_f0_kN_, r.speed_rev_per_s);
+    if (p.hold_play_allowance && eol_ && p.eol_backlash_rev > 0.0 && !friction_known_) {
+      // The hold's position is the motor's: inside the play the spindle may have stood.
+      const double b = 0.5 * p.eol_backlash_rev;
+      const double across_play_kN = clamp_kN(x_hold + b) - clamp_kN(x_hold - b);
+      hold_thr += std::min(std::abs(hold_curve_kN - hold_f0_kN_), across_play_kN);
+    }
     hold_threshold_kN_ = hold_thr;
     hold_over = std::abs(hold_change_kN_) > hold_thr;
   }

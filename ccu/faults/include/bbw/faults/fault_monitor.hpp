@@ -174,6 +174,13 @@ struct MonitorParams {
   // the change rule's reference does: its level and the positions it spanned hold only for the
   // samples it saw.
   bool hold_restart_untrusted = true;
+  // On a caliper with backlash, before the play's state is known (the hold's position is the
+  // motor's): the hold's allowance adds the curve's change over the positions the motor moved
+  // since the hold settled, at most its change across the play (the spindle, and the clamp force,
+  // may have stood while the motor crept inside the play). Without, a force loop creeping the motor
+  // 0.015 rev inside the play at a constant clamp force moved the residual by -0.77 kN on a caliper
+  // ten times stiffer (stiff10_ff runs 1, 129, 189).
+  bool hold_play_allowance = true;
   // Usable samples more than jump_max_gap_s apart (those between rejected by the guard, e.g. a
   // position beyond its range): the positions between went unseen, so the end-of-line friction
   // model's state (the play's, the sweep's) is forgotten and the rules' references restart, as
