@@ -2,7 +2,8 @@
 // one CornerSupervisor per corner (sample guard, calibrator, fault monitor, reactions), the
 // fused clamp-force estimate, and the per-corner commands (the scenario's demand, shared by the
 // Redistributor when a corner is unavailable). Pure: time is an argument; per-sample calls do
-// not allocate (test_ccu_core_no_alloc), except a corner's rejoin, which rebuilds its calibrator.
+// not allocate (test_ccu_core_no_alloc), except a corner's rejoin or a gap of unseen samples, which
+// rebuild its calibrator.
 #pragma once
 
 #include <array>
