@@ -156,6 +156,14 @@ TEST(SampleGuard, ClassifiesAndCountsEveryKindOfCorruptSample) {
   EXPECT_EQ(g.check(at(1, 0.001)).issue, SampleIssue::TimeBackwards);
   EXPECT_TRUE(g.check(at(1, 0.003)).usable());
   EXPECT_EQ(g.check(at(1, 0.004)).issue, SampleIssue::Duplicate);
+  // After a lost link the same process goes on: it may jump ahead (the outage's samples never
+  // came), but not back nor repeat; the next accepted sample restores the jump limits.
+  EXPECT_TRUE(g.check(at(2, 0.004)).usable());
+  g.rejoin(false);
+  EXPECT_EQ(g.check(at(1, 0.010)).issue, SampleIssue::SequenceBackwards);
+  EXPECT_EQ(g.check(at(2, 0.010)).issue, SampleIssue::Duplicate);
+  EXPECT_TRUE(g.check(at(2000000, 30.0)).usable());
+  EXPECT_EQ(g.check(at(4000000, 31.0)).issue, SampleIssue::Jump);
 }
 
 TEST(FaultMonitor, DefaultParametersAreValidAndInvalidOnesNameTheField) {

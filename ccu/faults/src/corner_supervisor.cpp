@@ -79,10 +79,10 @@ const CornerView& CornerSupervisor::tick(double now_s) {
 }
 
 void CornerSupervisor::rejoin() {
-  // The corner is back (after silence or a restart): its sequence may start again, and the
-  // calibrator restarts from the last good curve and friction stiffnesses (its cycle state
-  // does not survive the gap).
-  guard_.rejoin();
+  // The corner is back (after silence or a restart): the calibrator restarts from the last good
+  // curve and friction stiffnesses (its cycle state does not survive the gap). (The guard was
+  // told before the sample was checked, in on_sample: telling it again here opened its sequence
+  // checks to the next sample too.)
   restart_calibrator();
 }
 
@@ -127,7 +127,10 @@ void CornerSupervisor::react_to_new_findings() {
 
 const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arrival_s) {
   const bool was_lost = !monitor_.ok(Part::Network) || !monitor_.ok(Part::Process);
-  if (was_lost) guard_.rejoin();
+  // Only a lost process (a restart) may restart the sequence: after a lost link the same
+  // process goes on, and a sample numbered back is still not its (a hostile writer's, in a
+  // realtime run whose FL link was lost under load: accepted, it went back in sequence).
+  if (was_lost) guard_.rejoin(!monitor_.ok(Part::Process));
   const SampleCheck check = guard_.check(r);
   // Usable again after samples the guard rejected (a position beyond its range): the positions
   // between went unseen, so the calibrator's friction states and its cycle did not survive the

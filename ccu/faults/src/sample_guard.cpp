@@ -50,7 +50,10 @@ std::uint64_t SampleGuard::rejected() const {
   return n;
 }
 
-void SampleGuard::rejoin() { seq_continuity_ = false; }
+void SampleGuard::rejoin(bool sequence_restarts) {
+  jump_continuity_ = false;
+  if (sequence_restarts) seq_continuity_ = false;
+}
 
 SampleCheck SampleGuard::check(const CornerReading& r) {
   SampleCheck c;
@@ -70,7 +73,7 @@ SampleCheck SampleGuard::check(const CornerReading& r) {
     c.issue = SampleIssue::SequenceBackwards;
   } else if (have_last_ && !(r.time_s > last_time_s_)) {
     c.issue = SampleIssue::TimeBackwards;
-  } else if (have_last_ && seq_continuity_ &&
+  } else if (have_last_ && jump_continuity_ &&
              (static_cast<double>(r.seq - last_seq_) > limits_.max_sequence_jump ||
               r.time_s - last_time_s_ > limits_.max_time_jump_s)) {
     c.issue = SampleIssue::Jump;
@@ -82,6 +85,7 @@ SampleCheck SampleGuard::check(const CornerReading& r) {
   }
   have_last_ = true;
   seq_continuity_ = true;
+  jump_continuity_ = true;
   last_seq_ = r.seq;
   last_time_s_ = r.time_s;
   c.load_cell_present = !lc_nan;

@@ -50,9 +50,12 @@ class SampleGuard {
   explicit SampleGuard(const GuardLimits& limits);  // throws std::invalid_argument
 
   SampleCheck check(const CornerReading& r);
-  // A new incarnation of the corner (a restarted process): its sequence may start again;
-  // its time must still move forward (the scenario's time base continues).
-  void rejoin();
+  // The corner is back after it was lost. A new incarnation (a restarted process,
+  // sequence_restarts): its sequence may start again. The same process after a lost link: its
+  // sequence goes on, so it may not go back nor repeat, but it may jump ahead (the samples of the
+  // outage were never delivered). Either way its time must still move forward (the scenario's
+  // time base continues), and the next accepted sample restores every check.
+  void rejoin(bool sequence_restarts = true);
 
   std::uint64_t count(SampleIssue i) const { return counts_[static_cast<std::size_t>(i)]; }
   std::uint64_t rejected() const;
@@ -64,7 +67,8 @@ class SampleGuard {
  private:
   GuardLimits limits_;
   bool have_last_ = false;
-  bool seq_continuity_ = true;  // false after rejoin() until the next accepted sample
+  bool seq_continuity_ = true;   // false after rejoin(true) until the next accepted sample
+  bool jump_continuity_ = true;  // false after any rejoin() until the next accepted sample
   std::uint64_t last_seq_ = 0;
   double last_time_s_ = 0.0;
   std::array<std::uint64_t, kSampleIssueCount> counts_{};
