@@ -35,8 +35,9 @@ MonitorParams for_calibrator(MonitorParams p, const calibration::CalibratorConfi
 // The calibrator beside this guard: it accepts every position the guard does (a sample the guard
 // passes and the calibrator refuses leaves its friction states behind; see guard_position_from_eol).
 // (Only where the guard's range was widened: a calibrator configured narrower keeps its range.)
-calibration::CalibratorConfig accepting(calibration::CalibratorConfig c, const MonitorParams& m) {
-  const double guard_max_rev = guard_for_corner(m).position_max_rev;
+calibration::CalibratorConfig accepting(calibration::CalibratorConfig c, const MonitorParams& m,
+                                        const GuardLimits& guard) {
+  const double guard_max_rev = guard.position_max_rev;
   if (guard_max_rev > m.guard.position_max_rev) c.accept_position_max_rev = std::max(c.accept_position_max_rev, guard_max_rev);
   return c;
 }
@@ -55,9 +56,13 @@ const char* to_string(EstimateSource s) {
 
 CornerSupervisor::CornerSupervisor(const calibration::CalibratorConfig& calibrator, const MonitorParams& monitor,
                                    Target corner)
-    : config_(accepting(calibrator, monitor)),
+    : CornerSupervisor(calibrator, monitor, corner, guard_for_corner(monitor)) {}
+
+CornerSupervisor::CornerSupervisor(const calibration::CalibratorConfig& calibrator, const MonitorParams& monitor,
+                                   Target corner, const GuardLimits& guard)
+    : config_(accepting(calibrator, monitor, guard)),
       corner_(corner),
-      guard_(guard_for_corner(monitor)),
+      guard_(guard),
       calibrator_(std::in_place, config_),
       monitor_(for_calibrator(monitor, calibrator), corner),
       last_good_(*calibrator_),

@@ -502,25 +502,27 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   hold_threshold_kN_ = std::numeric_limits<double>::quiet_NaN();
   const bool hold_was_set = hold_ref_;
   if (slow && !hold_ref_) {
-    if (hold_slow_ == 0) {  // the definition the reference is averaged under
+    // The settle's start: the definition the reference is averaged under, and its positions.
+    // (Within a settle the definition cannot change: a change restarts it above.)
+    const auto begin_settle = [&] {
+      hold_slow_ = 0;
+      hold_sum_kN_ = 0.0;
       hold_eol_mode_ = eol_here;
       hold_known_ = friction_known_;
       hold_x_min_rev_ = hold_x_max_rev_ = x_hold;
       hold_scale0_ = friction_scale_;
+    };
+    if (hold_slow_ == 0) {
+      begin_settle();
+    } else if (hold_slow_ + 1 >= p.hold_settle_samples && p.hold_settled_within_kN > 0.0 &&
+               std::max(hold_settle_max_kN_, residual_kN_) - std::min(hold_settle_min_kN_, residual_kN_) >
+                   p.hold_settled_within_kN) {
+      begin_settle();  // not settled: again from this sample (its definition and positions as they are now)
     }
     ++hold_slow_;
     hold_sum_kN_ += residual_kN_;
     hold_settle_min_kN_ = hold_slow_ == 1 ? residual_kN_ : std::min(hold_settle_min_kN_, residual_kN_);
     hold_settle_max_kN_ = hold_slow_ == 1 ? residual_kN_ : std::max(hold_settle_max_kN_, residual_kN_);
-    if (hold_slow_ >= p.hold_settle_samples && p.hold_settled_within_kN > 0.0 &&
-        hold_settle_max_kN_ - hold_settle_min_kN_ > p.hold_settled_within_kN) {
-      // Not settled: again from this sample (its definition and positions as they are now).
-      hold_slow_ = 1;
-      hold_sum_kN_ = residual_kN_;
-      hold_settle_min_kN_ = hold_settle_max_kN_ = residual_kN_;
-      hold_x_min_rev_ = hold_x_max_rev_ = x_hold;
-      hold_scale0_ = friction_scale_;
-    }
     if (hold_slow_ >= p.hold_settle_samples) {
       hold_ref_ = true;
       hold_r0_kN_ = hold_sum_kN_ / hold_slow_;

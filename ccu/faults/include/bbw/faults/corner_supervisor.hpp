@@ -69,6 +69,10 @@ class CornerSupervisor {
   Target corner() const { return corner_; }
 
  private:
+  // The guard's limits are computed once (guard_for_corner) and given to both the guard and the
+  // calibrator's accept range.
+  CornerSupervisor(const calibration::CalibratorConfig& calibrator, const MonitorParams& monitor, Target corner,
+                   const GuardLimits& guard);
   void resume_after_dropout();
   void resume_after_resolver();
   void restart_calibrator();
