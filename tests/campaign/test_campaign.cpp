@@ -92,6 +92,9 @@ TEST(CampaignSpec, BadInputNamesLineKeyAndRule) {
   s = good();
   s.replace(s.find("[viscous_friction, sensor_delay, backlash]"), 42, "[]");
   fails(s, "key 'effects'");
+  fails(good() + "pace: [0.1, 2]\n", "t.yaml:17: key 'pace[0]': must be in [0.25, 4]");
+  fails(good() + "pace: [2, 1.5]\n", "min must be <= max");
+  fails(good() + "pace: [2]\n", "must be [min, max]");
 }
 
 CampaignSpec spec() { return load_campaign_spec_string(good(), "t.yaml"); }
@@ -197,6 +200,49 @@ TEST(CampaignDraw, EveryProfilesDemandLoadsEvenWhereItsCutFallsOnAPoint) {
     const std::string yaml = scenario_yaml(s, r, plant);
     ASSERT_NO_THROW(faults::load_fault_scenario_string(yaml, "run.yaml")) << "run " << i << "\n" << yaml;
   }
+}
+
+// A driver's pace (`pace`): the same demand, each step in 1/pace of the time. Without the key a
+// campaign draws what it drew before the key existed (pace 1, no extra draw).
+TEST(CampaignDraw, APaceCompressesTheDriversDemandAndEveryPacedDrawLoads) {
+  CampaignSpec slow = spec();
+  slow.profiles = {Profile::City};
+  slow.fault_free_share = 1.0;
+  CampaignSpec fast = slow;
+  fast.pace_min = fast.pace_max = 2.0;
+  const std::string plant = src("config/plant/ecaliper.yaml");
+  for (int i = 0; i < slow.runs; ++i) {
+    const RunPlan a = draw_run(slow, i), b = draw_run(fast, i);
+    EXPECT_EQ(a.pace, 1.0);
+    EXPECT_EQ(b.pace, 2.0);
+    EXPECT_EQ(scenario_yaml(slow, a, plant).find("pace"), std::string::npos);
+    EXPECT_NE(scenario_yaml(fast, b, plant).find("pace 2.0"), std::string::npos);
+    ASSERT_GT(b.demand.size(), a.demand.size());  // twice the steps in the same time
+    const double end_s = a.duration_s - 0.5;
+    int compared = 0;
+    for (std::size_t k = 0; k < a.demand.size() && a.demand[k].first < end_s; ++k, ++compared) {
+      EXPECT_NEAR(b.demand[k].first, a.demand[k].first / 2.0, 1e-12) << "run " << i << " point " << k;
+      EXPECT_EQ(b.demand[k].second, a.demand[k].second) << "run " << i << " point " << k;
+    }
+    EXPECT_GT(compared, 5);
+    EXPECT_EQ(b.demand.back().first, b.duration_s);  // the run still ends released at its end
+    EXPECT_EQ(b.demand.back().second, 0.0);
+  }
+  // Drawn per run within [min, max]; every profile's paced draw loads.
+  CampaignSpec wide = spec();
+  wide.profiles = {Profile::City, Profile::Abs, Profile::SlowRamps, Profile::LongHold, Profile::HardStopStart,
+                   Profile::HardStopRelease};
+  wide.pace_min = 1.5;
+  wide.pace_max = 2.5;
+  wide.runs = 60;
+  std::set<double> paces;
+  for (int i = 0; i < wide.runs; ++i) {
+    const RunPlan r = draw_run(wide, i);
+    EXPECT_TRUE(r.pace >= 1.5 && r.pace <= 2.5) << r.pace;
+    paces.insert(r.pace);
+    ASSERT_NO_THROW(faults::load_fault_scenario_string(scenario_yaml(wide, r, plant), "run.yaml")) << "run " << i;
+  }
+  EXPECT_GT(paces.size(), 50u);
 }
 
 // Above the detectability limit: by magnitude; a drift also by the offset it reaches (a bias's

@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <cstdlib>
 #include <fstream>
@@ -158,7 +159,8 @@ TEST(CampaignSystem, AKilledCampaignResumesAndRunsOnlyWhatIsMissing) {
   EXPECT_EQ(fs::last_write_time(dir + "/c/runs/00001/result.json"), kept_time);
   // The resumed campaign scores as the uninterrupted one (run 3 is drawn and run again alike).
   const YAML::Node a = YAML::Load(before), b = YAML::LoadFile(dir + "/c/campaign.json");
-  for (const char* k : {"faults", "detected", "correct", "latency_p50_ms", "latency_max_ms", "harm_max_force_error_kN"}) {
+  for (const char* k : {"faults", "detected", "correct", "latency_p50_ms", "latency_max_ms", "harm_max_force_error_kN",
+                        "after_detection_estimate_error_max_kN"}) {
     EXPECT_EQ(a["overall"][k].as<std::string>(), b["overall"][k].as<std::string>()) << k;
   }
   EXPECT_EQ(a["false_alarms"]["in_fault_free_runs"].as<int>(), b["false_alarms"]["in_fault_free_runs"].as<int>());
@@ -190,6 +192,11 @@ TEST(CampaignSystem, DdsAndMemoryScoreARunAlike) {
       EXPECT_EQ(a["faults"][k]["detected"].as<bool>(), b["faults"][k]["detected"].as<bool>()) << run;
       EXPECT_DOUBLE_EQ(a["faults"][k]["latency_ms"].as<double>(), b["faults"][k]["latency_ms"].as<double>()) << run;
       EXPECT_DOUBLE_EQ(a["faults"][k]["harm_force_error_kN"].as<double>(), b["faults"][k]["harm_force_error_kN"].as<double>()) << run;
+      if (a["faults"][k]["detected"].as<bool>()) {  // (null while undetected)
+        const double after = a["faults"][k]["after_estimate_error_kN"].as<double>();
+        EXPECT_TRUE(std::isfinite(after) && after >= 0.0) << run;
+        EXPECT_DOUBLE_EQ(after, b["faults"][k]["after_estimate_error_kN"].as<double>()) << run;
+      }
     }
     EXPECT_EQ(a["false_alarms"].size(), b["false_alarms"].size()) << run;
   }

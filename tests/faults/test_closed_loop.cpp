@@ -572,6 +572,11 @@ TEST(ClosedLoopIssue14, AfterALoadCellFindingAHealthyDriveOnAnUncalibratedCurveI
   EXPECT_EQ(r.faults_raised(), 1u);
   auto opts = default_options();
   opts.monitor.torque_lost_unmeasured_load_high = false;
+  // (Left with the configured curve, the shipped caliper's, as when the rule was made: with this
+  // caliper's own end-of-line curve, calibrator_start.initial_curve_from_end_of_line and
+  // load_cell_lost.curve_from_end_of_line_beyond_data, the curve no longer reads it low.)
+  opts.monitor.calibrator_initial_curve_from_eol = false;
+  opts.monitor.lost_load_cell_curve_from_eol = false;
   const auto base = run_closed_loop(fs, opts);
   ASSERT_TRUE(base.outcomes[0].detected && base.outcomes[0].correct);
   ASSERT_TRUE(rr(base).present);  // the load as the curve says: a healthy drive named
@@ -805,7 +810,12 @@ TEST(ClosedLoopIssue14, ALoadCellThatDriftsWithTemperatureRaisesNothingAndABiasI
 TEST(ClosedLoopIssue14, AViscousCaliperReversingFastRaisesNothingAndABiasIsStillNamed) {
   expect_effect_model_holds("config/scenarios/faults/fault_free_viscous_caliper_fast_reversal.yaml",
                             "config/scenarios/faults/load_cell_bias_in_a_fast_reversal_of_a_viscous_caliper.yaml",
-                            "viscous model", [](MonitorParams& m) { m.eol_viscous_model = false; });
+                            "viscous model", [](MonitorParams& m) {
+                              m.eol_viscous_model = false;
+                              // (Its calibrator started from the configured curve, as when the
+                              // rule was made: from the caliper's own, the residual stays within it.)
+                              m.calibrator_initial_curve_from_eol = false;
+                            });
 }
 
 // A +1.08 kN/s drift before the first fit on that kind of caliper (tuning seed 1401, run 22): the
@@ -900,6 +910,75 @@ TEST(ClosedLoopIssue14, ASoftCalipersTravelBeyondTenRevIsNotCorrupt) {
   EXPECT_GT(base.guard_rejected[fl], 100u);
   std::printf("FL's samples rejected: %llu with the end-of-line range, %llu with 10 rev\n",
               static_cast<unsigned long long>(r.guard_rejected[fl]), static_cast<unsigned long long>(base.guard_rejected[fl]));
+}
+
+namespace {
+
+// The worst |estimate - clamp force| of a corner from `from_s` on (its load cell lost), with the
+// monitor changed by `change`, and whether the run raised that corner's load-cell finding only
+// (besides the scenario's other faults, named in `others`).
+struct LostLoadCellRun {
+  double worst_kN = 0.0, worst_at_s = 0.0;
+  bool only_its_faults = false;
+};
+LostLoadCellRun lost_load_cell_run(const FaultScenario& fs, std::size_t corner, double from_s, std::size_t others,
+                                   const std::function<void(MonitorParams&)>& change) {
+  auto opts = default_options();
+  change(opts.monitor);
+  const auto r = run_closed_loop(fs, opts);
+  LostLoadCellRun seen;
+  for (const auto& p : r.periods) {
+    if (p.time_s < from_s || !std::isfinite(p.true_kN[corner]) || !std::isfinite(p.estimate_kN[corner])) continue;
+    const double e = std::abs(p.estimate_kN[corner] - p.true_kN[corner]);
+    if (e > seen.worst_kN) seen = LostLoadCellRun{e, p.time_s, false};
+  }
+  seen.only_its_faults =
+      r.faults_raised() == 1 + others && r.diagnoses[corner * 5 + static_cast<std::size_t>(Part::LoadCell)].active;
+  return seen;
+}
+
+}  // namespace
+
+// A soft caliper's load cell lost in a hard stop beyond the calibrator's range (faster-driver
+// campaign `fast`, run 68: the extreme population's member 14, 0.4 x as stiff as the shipped
+// caliper; RL's dropout at 7.467 s in a 14.7 kN hold at 7.7 rev; its fits had data over 3.8-6 rev).
+// Its calibrator started from the shipped caliper's curve, which its fits replaced only over
+// 3.8-6 rev: released at 1.4-2.4 rev the curve it was left with read 5-8 kN where it clamped 1,
+// and the CCU named an actuator that released as not releasing. Now it starts from the caliper's
+// own end-of-line curve (calibrator_start.initial_curve_from_end_of_line).
+TEST(ClosedLoopIssue14, ASoftCalipersLostLoadCellLeavesACurveThatFollowsItsClampForce) {
+  const auto fs = load("config/scenarios/faults/soft_caliper_load_cell_lost_in_a_hard_stop.yaml");
+  const std::size_t rl = 2;
+  const auto both = lost_load_cell_run(fs, rl, 7.5, 0, [](MonitorParams&) {});
+  const auto no_start = lost_load_cell_run(fs, rl, 7.5, 0, [](MonitorParams& m) { m.calibrator_initial_curve_from_eol = false; });
+  const auto neither = lost_load_cell_run(fs, rl, 7.5, 0, [](MonitorParams& m) {
+    m.calibrator_initial_curve_from_eol = false;
+    m.lost_load_cell_curve_from_eol = false;
+  });
+  std::printf("RL's estimate after its load cell was lost, worst |estimate - clamp force|: %.2f kN (at %.2f s) with the "
+              "end-of-line start, %.2f (%.2f s) without it, %.2f (%.2f s) without it and the bridge\n",
+              both.worst_kN, both.worst_at_s, no_start.worst_kN, no_start.worst_at_s, neither.worst_kN, neither.worst_at_s);
+  EXPECT_LT(both.worst_kN, 1.0);
+  EXPECT_TRUE(both.only_its_faults);
+  EXPECT_GT(no_start.worst_kN, 2.5);
+  EXPECT_GT(neither.worst_kN, 5.0);
+  EXPECT_FALSE(neither.only_its_faults);
+}
+
+// A load cell stuck before the first fit in a hard stop at 9.4 rev, on a caliper ten times softer
+// (soft10 campaign, seed 2906, run 72, FL; without that run's link delay on RR). Beyond the calibrator's
+// 1-6 rev its starting cubic, extrapolated, was 11 kN off. Now the caliper's end-of-line curve
+// carries the curve beyond where the fits had data (load_cell_lost.curve_from_end_of_line_beyond_data).
+TEST(ClosedLoopIssue14, BeyondTheFitsDataTheEndOfLineCurveCarriesALostLoadCellsCurve) {
+  const auto fs = load("config/scenarios/faults/soft_caliper_load_cell_stuck_beyond_the_calibrators_range.yaml");
+  const std::size_t fl = 0;
+  const auto with = lost_load_cell_run(fs, fl, 0.87, 0, [](MonitorParams&) {});
+  const auto without = lost_load_cell_run(fs, fl, 0.87, 0, [](MonitorParams& m) { m.lost_load_cell_curve_from_eol = false; });
+  std::printf("FL's estimate after its load cell stuck, worst |estimate - clamp force|: %.2f kN (at %.2f s) with the "
+              "bridge, %.2f (%.2f s) without\n", with.worst_kN, with.worst_at_s, without.worst_kN, without.worst_at_s);
+  EXPECT_LT(with.worst_kN, 1.0);
+  EXPECT_TRUE(with.only_its_faults);
+  EXPECT_GT(without.worst_kN, 5.0);
 }
 
 // A hold's reference is set only from settle samples that lie within hold.settled_within_kN of
@@ -1100,11 +1179,16 @@ TEST(ClosedLoopIssue14, AReleaseOnTheCurveAfterALoadCellFindingStopsAtThePads) {
   const auto r = run_closed_loop(fs, default_options());
   expect_stops_at_the_pads(r, "shipped");
   fs.scenario.controller.feedback_switch_restart = false;
-  const auto wound = run_closed_loop(fs, default_options());
+  // (Left with the configured curve, as when the restart was made: with the caliper's own
+  // end-of-line curve the curve it is left with is near enough that the loop does not wind up.)
+  auto configured_start = default_options();
+  configured_start.monitor.calibrator_initial_curve_from_eol = false;
+  configured_start.monitor.lost_load_cell_curve_from_eol = false;
+  const auto wound = run_closed_loop(fs, configured_start);
   EXPECT_GT(off_s(wound), 0.1);
   ASSERT_TRUE(fr(wound).present);
   fs.scenario.controller.force_integral_max_speed_error_rev_per_s = 2.0;
-  expect_stops_at_the_pads(run_closed_loop(fs, default_options()), "the integral option alone");
+  expect_stops_at_the_pads(run_closed_loop(fs, configured_start), "the integral option alone");
   std::printf("brake off while >= 2 kN commanded: %.0f ms; without the restart at the switch %.0f ms and %s at %.3f s\n",
               1e3 * off_s(r), 1e3 * off_s(wound), to_string(fr(wound).finding), fr(wound).detected_s);
 }
@@ -1121,6 +1205,7 @@ TEST(ClosedLoopIssue14, AfterANamedTorqueLossTheTestsJudgeTheMotorThatIsLeft) {
   EXPECT_EQ(r.faults_raised(), 2u);
   auto opts = default_options();
   opts.monitor.test_pulse_rescaled_after_loss = false;
+  opts.monitor.calibrator_initial_curve_from_eol = false;  // (as when the rule was made)
   const auto base = run_closed_loop(fs, opts);
   const auto named_lost = [](const LoopResult& x) {
     for (const auto& d : x.diagnoses) {

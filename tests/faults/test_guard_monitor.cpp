@@ -11,6 +11,7 @@
 #include <random>
 
 #include "bbw/calibration/config_yaml.hpp"
+#include "bbw/faults/bridged_curve.hpp"
 #include "bbw/faults/corner_supervisor.hpp"
 #include "bbw/faults/detectors/jump_detector.hpp"
 #include "bbw/faults/fault_monitor.hpp"
@@ -730,6 +731,45 @@ TEST(FaultMonitor, ALostActuatorThatDoesNotReleaseIsUpgraded) {
   EXPECT_GT(d.finding_s, first_s + 0.2);
 }
 
+// The curve a lost load cell leaves (bridge_curve): where the fit had data, the fit; beyond, the
+// caliper's end-of-line curve's rise from the span's end; before any fit, the end-of-line curve.
+// A caliper 0.4 x as stiff as the shipped one, fitted over 3.8-6 rev only (as the faster-driver
+// campaign's run 68): the fit extrapolated is kN off at 2 and 7.7 rev, the bridged curve is not.
+TEST(BridgeCurve, KeepsTheFitWhereItHadDataAndTheEndOfLineRiseBeyond) {
+  bbw::plant::ClampCurveParams soft;
+  soft.exp_coefficient_kN *= 0.4;
+  soft.linear_kN_per_rev *= 0.4;
+  const bbw::plant::ClampCurve eol(soft);
+  const double t_C = 72.5;
+  auto truth = [&](double x) { return eol.force_kN(x, t_C, 0.0); };
+  // The fit: true over its data (a cubic through the truth on 3.8-6 rev), 0.3 kN high there.
+  bbw::model::Curve fit = bridge_curve({}, DataSpan{}, eol, t_C, 3.8, 6.0);
+  fit.d += 0.3;
+  const DataSpan data{3.8, 6.0};
+  const double to_rev = eol_position_at(eol, 40.0, t_C, 1.0, 1000.0);  // as the supervisor does
+  const bbw::model::Curve bridged = bridge_curve(fit, data, eol, t_C, 1.0, to_rev);
+  double worst_fit_outside = 0.0, worst_bridged = 0.0;  // (kN, and kN beyond 3 % of the force)
+  for (double x = 1.0; x <= to_rev; x += 0.05) {
+    const double expected = truth(x) + 0.3;  // the fit's error carried on, continuous at its ends
+    worst_bridged = std::max(worst_bridged, std::abs(bridged.force_kN(x) - expected) - 0.03 * expected);
+    if (x < data.lo_rev || x > data.hi_rev) worst_fit_outside = std::max(worst_fit_outside, std::abs(fit.force_kN(x) - truth(x)));
+  }
+  EXPECT_LT(worst_bridged, 0.4);
+  EXPECT_GT(worst_fit_outside, 2.0);
+  std::printf("worst error over 1-%.2f rev: bridged %.3f kN + 3 %% of the force (to the fit's level), the fit extrapolated %.3f kN\n",
+              to_rev, worst_bridged, worst_fit_outside);
+  // No data: the end-of-line curve itself.
+  const bbw::model::Curve none = bridge_curve(fit, DataSpan{}, eol, t_C, 1.0, to_rev);
+  for (double x = 1.0; x <= to_rev; x += 0.25) EXPECT_NEAR(none.force_kN(x), truth(x), 0.4 + 0.03 * truth(x)) << x;
+  EXPECT_THROW(bridge_curve(fit, data, eol, t_C, 6.0, 6.0), std::invalid_argument);
+  EXPECT_THROW(bridge_curve(fit, data, eol, t_C, 1.0, std::nan("")), std::invalid_argument);
+  // Where the end-of-line curve reaches a force (and the range's end where it does not).
+  const double x40 = eol_position_at(eol, 40.0, t_C, 1.0, 1000.0);
+  EXPECT_NEAR(truth(x40), 40.0, 1e-4);
+  EXPECT_DOUBLE_EQ(eol_position_at(eol, 40.0, t_C, 1.0, 5.0), 5.0);
+  EXPECT_DOUBLE_EQ(eol_position_at(eol, 0.0, t_C, 1.0, 5.0), 1.0);
+}
+
 TEST(LastGoodCalibration, GivesTheNewestSnapshotBeforeATime) {
   const auto cfg = test::default_options().calibrator;
   bbw::calibration::Calibrator c(cfg);
@@ -740,10 +780,12 @@ TEST(LastGoodCalibration, GivesTheNewestSnapshotBeforeATime) {
     bbw::calibration::Curve curve = cfg.initial_curve;
     curve.d = k;
     c.reset_curve(curve);
-    g.push(k, c);
+    g.push(k, c, DataSpan{1.0, 1.0 + k});
   }
   EXPECT_EQ(g.size(), LastGoodCalibration::kCapacity);
   EXPECT_DOUBLE_EQ(g.before(4.5).curve.d, 4.0);
+  EXPECT_DOUBLE_EQ(g.before(4.5).data.hi_rev, 5.0);  // its data span with it
+  EXPECT_TRUE(g.before(1.0).data.empty());           // the initial state: no data
   EXPECT_DOUBLE_EQ(g.before(4.0).curve.d, 3.0);
   EXPECT_DOUBLE_EQ(g.newest().curve.d, 6.0);
   EXPECT_FALSE(g.before(2.5).from_fit);  // older than the ring holds: the initial state

@@ -154,6 +154,8 @@ std::size_t Calibrator::state_bytes() const {
 void Calibrator::reset_curve(const Curve& curve) {
   curve_ = curve;
   for (std::size_t k = 0; k < pf_x_rev_.size(); ++k) pf_f_kN_[k] = curve_.force_kN(pf_x_rev_[k]);
+  stats_.curve_data_min_rev = 1.0;  // no fit's data behind it
+  stats_.curve_data_max_rev = 0.0;
 }
 
 void Calibrator::set_friction_stiffness(const std::vector<double>& k_kN_per_rev) {
@@ -315,6 +317,7 @@ bool Calibrator::end_cycle() {
       const double local = ((c3 * u + c2) * u + c1) * u + c0;
       pf_f_kN_[k] = robust_ ? curve_.force_kN(X) + local : local;
     }
+    note_curve_data(x_lo, x_hi);
     refit_curve_from_pf();
   }
   // Friction amplitudes.
@@ -458,6 +461,7 @@ bool Calibrator::end_cycle_with_memory() {
       const double u = scaled_ ? (X - xc_rev_) / xh_rev_ : X;
       pf_f_kN_[k] = curve_.force_kN(X) + ((theta_[3] * u + theta_[2]) * u + theta_[1]) * u + theta_[0];
     }
+    note_curve_data(x_lo, x_hi);
     refit_curve_from_pf();
   }
   for (std::size_t i = 0; i < q; ++i) {
@@ -615,6 +619,14 @@ Estimate Calibrator::update(const Sample& s) {
   }
   e.calibrated = stats_.fits_accepted > 0;
   return e;
+}
+
+void Calibrator::note_curve_data(double x_lo_rev, double x_hi_rev) {
+  const double lo = std::max(x_lo_rev, config_.x_min_rev), hi = std::min(x_hi_rev, config_.x_max_rev);
+  if (!(hi >= lo)) return;
+  const bool none = !(stats_.curve_data_max_rev >= stats_.curve_data_min_rev);
+  stats_.curve_data_min_rev = none ? lo : std::min(stats_.curve_data_min_rev, lo);
+  stats_.curve_data_max_rev = none ? hi : std::max(stats_.curve_data_max_rev, hi);
 }
 
 }  // namespace bbw::calibration

@@ -1,5 +1,7 @@
 #include "bbw/faults/corner_supervisor.hpp"
 
+#include "bbw/faults/bridged_curve.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -42,6 +44,20 @@ calibration::CalibratorConfig accepting(calibration::CalibratorConfig c, const M
   return c;
 }
 
+// The calibrator's starting curve: with an end-of-line curve (and calibrator_start.initial_curve_
+// from_end_of_line), that caliper's own, as a cubic over the calibrator's range at its reference
+// temperature; the configured one (the shipped caliper's) otherwise. Its fits replace it only
+// where their cycles had data: elsewhere a caliper 0.4 x as stiff kept the shipped caliper's
+// forces, 5-8 kN where it clamped 1 (faster-driver campaign run 68).
+calibration::CalibratorConfig starting(calibration::CalibratorConfig c, const MonitorParams& m) {
+  // (An empty range is the calibrator's to refuse, with its own message.)
+  if (!m.calibrator_initial_curve_from_eol || !m.eol_curve || !(c.x_max_rev > c.x_min_rev)) return c;
+  const plant::ClampCurve eol(*m.eol_curve);
+  c.initial_curve = bridge_curve(c.initial_curve, DataSpan{}, eol, m.eol_curve->reference_temperature_C, c.x_min_rev,
+                                 c.x_max_rev);
+  return c;
+}
+
 }  // namespace
 
 const char* to_string(EstimateSource s) {
@@ -60,13 +76,13 @@ CornerSupervisor::CornerSupervisor(const calibration::CalibratorConfig& calibrat
 
 CornerSupervisor::CornerSupervisor(const calibration::CalibratorConfig& calibrator, const MonitorParams& monitor,
                                    Target corner, const GuardLimits& guard)
-    : config_(accepting(calibrator, monitor, guard)),
+    : config_(accepting(starting(calibrator, monitor), monitor, guard)),
       corner_(corner),
       guard_(guard),
       calibrator_(std::in_place, config_),
       monitor_(for_calibrator(monitor, calibrator), corner),
       last_good_(*calibrator_),
-      trusted_curve_(calibrator.initial_curve) {
+      trusted_curve_(config_.initial_curve) {
   view_.curve = trusted_curve_;
   view_.force_limit_kN = monitor.force_limit_kN;
   if (monitor.eol_curve) eol_.emplace(*monitor.eol_curve);
@@ -110,6 +126,7 @@ void CornerSupervisor::restart_calibrator() {
   cfg.initial_curve = good.curve;
   calibrator_.emplace(cfg);
   calibrator_->set_friction_stiffness(good.stiffness_kN_per_rev);
+  curve_data_ = good.data;
   fusion_.reset();
   last_fed_time_s_ = std::numeric_limits<double>::quiet_NaN();
   ++restarts_;
@@ -119,7 +136,16 @@ void CornerSupervisor::react_to_new_findings() {
   if (!monitor_.ok(Part::LoadCell) && !load_cell_reacted_) {
     // Back to the newest curve fitted before the fault began; the load cell is no longer used.
     load_cell_reacted_ = true;
-    trusted_curve_ = last_good_.before(monitor_.diagnosis(Part::LoadCell).onset_s).curve;
+    const CalibrationSnapshot& good = last_good_.before(monitor_.diagnosis(Part::LoadCell).onset_s);
+    trusted_curve_ = good.curve;
+    const MonitorParams& p = monitor_.params();
+    if (eol_ && p.lost_load_cell_curve_from_eol) {
+      // Where the fit had no data, the caliper's own end-of-line curve rises as the caliper does.
+      const double t_C = std::isfinite(last_temperature_C_) ? last_temperature_C_ : eol_->params().reference_temperature_C;
+      const double to_rev = std::max(p.curve_max_rev, eol_position_at(*eol_, p.force_limit_kN, t_C, p.curve_min_rev,
+                                                                       guard_.limits().position_max_rev));
+      trusted_curve_ = bridge_curve(good.curve, good.data, *eol_, t_C, p.curve_min_rev, to_rev);
+    }
   }
   if (!monitor_.ok(Part::Resolver) && !resolver_reacted_) {
     resolver_reacted_ = true;
@@ -137,6 +163,7 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
   // realtime run whose FL link was lost under load: accepted, it went back in sequence).
   if (was_lost) guard_.rejoin(!monitor_.ok(Part::Process));
   const SampleCheck check = guard_.check(r);
+  if (check.usable() && std::isfinite(r.temperature_C)) last_temperature_C_ = r.temperature_C;
   // Usable again after samples the guard rejected (a position beyond its range): the positions
   // between went unseen, so the calibrator's friction states and its cycle did not survive the
   // gap either; it restarts from the last good curve, as after a rejoin (its fused estimate,
@@ -181,7 +208,16 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
   react_to_new_findings();
   if (fed != nullptr && e.valid) {
     if (e.fit_accepted && monitor_.ok(Part::LoadCell) && monitor_.ok(Part::Resolver)) {
-      last_good_.push(r.time_s, *calibrator_);
+      // Where its curve had data: its own accepted fits' and, after a restart, the snapshot's it
+      // started from.
+      const calibration::Stats& st = calibrator_->stats();
+      DataSpan data{st.curve_data_min_rev, st.curve_data_max_rev};
+      if (data.empty()) {
+        data = curve_data_;
+      } else if (!curve_data_.empty()) {
+        data = DataSpan{std::min(data.lo_rev, curve_data_.lo_rev), std::max(data.hi_rev, curve_data_.hi_rev)};
+      }
+      last_good_.push(r.time_s, *calibrator_, data);
       monitor_.set_curve_range(fed_min_rev_, fed_max_rev_);  // the fits had data here
       monitor_.set_fit_rms(calibrator_->stats().last_fit_rms_kN);  // its model uncertainty
       monitor_.set_fit_friction_amplitude(friction_amplitude_kN(calibrator_->friction()));

@@ -1,5 +1,7 @@
 #include "bbw/faults/fault_monitor.hpp"
 
+#include "bbw/faults/bridged_curve.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -252,21 +254,9 @@ GuardLimits guard_for_corner(const MonitorParams& p) {
   if (!p.guard_position_from_eol || !p.eol_curve) return g;
   const plant::ClampCurve curve(*p.eol_curve);
   const double t_C = p.eol_curve->reference_temperature_C;
-  auto below = [&](double x_rev) { return curve.force_kN(x_rev, t_C, 0.0) < g.load_cell_max_kN; };
-  if (!below(g.position_max_rev)) return g;
-  // The curve rises with the position: doubled until it reaches the range (at most 1000 rev, a
-  // curve that never does), then bisected to 1e-6 rev.
-  constexpr double kMostRev = 1000.0;
-  double lo = g.position_max_rev, hi = std::max(2.0 * lo, lo + 1.0);
-  while (hi < kMostRev && below(hi)) {
-    lo = hi;
-    hi = std::min(kMostRev, 2.0 * hi);
-  }
-  while (hi - lo > 1e-6) {
-    const double mid = 0.5 * (lo + hi);
-    (below(mid) ? lo : hi) = mid;
-  }
-  g.position_max_rev = hi;
+  if (curve.force_kN(g.position_max_rev, t_C, 0.0) >= g.load_cell_max_kN) return g;
+  // (At most 1000 rev, a curve that never reaches the range.)
+  g.position_max_rev = eol_position_at(curve, g.load_cell_max_kN, t_C, g.position_max_rev, 1000.0);
   return g;
 }
 

@@ -11,7 +11,7 @@ LastGoodCalibration::LastGoodCalibration(const calibration::Calibrator& initial)
   for (auto& s : ring_) s.stiffness_kN_per_rev.assign(m, 0.0);
 }
 
-void LastGoodCalibration::push(double time_s, const calibration::Calibrator& c) {
+void LastGoodCalibration::push(double time_s, const calibration::Calibrator& c, const DataSpan& data) {
   CalibrationSnapshot& s = ring_[head_];
   s.time_s = time_s;
   s.curve = c.curve();
@@ -19,6 +19,7 @@ void LastGoodCalibration::push(double time_s, const calibration::Calibrator& c) 
   std::copy(k.begin(), k.begin() + static_cast<std::ptrdiff_t>(std::min(k.size(), s.stiffness_kN_per_rev.size())),
             s.stiffness_kN_per_rev.begin());
   s.from_fit = true;
+  s.data = data;
   head_ = (head_ + 1) % kCapacity;
   count_ = std::min(count_ + 1, kCapacity);
 }

@@ -157,6 +157,14 @@ MonitorParams read_monitor_params(Reader& r) {
   p.dropout_clear_samples = static_cast<int>(d.integer("clear_samples", 1, 100000));
   d.finish();
 
+  auto lost = r.map("load_cell_lost");
+  p.lost_load_cell_curve_from_eol = lost.boolean("curve_from_end_of_line_beyond_data");
+  lost.finish();
+
+  auto start = r.map("calibrator_start");
+  p.calibrator_initial_curve_from_eol = start.boolean("initial_curve_from_end_of_line");
+  start.finish();
+
   auto t = r.map("torque");
   p.torque_filter_s = t.number("filter_s", pos);
   p.torque_check_min_load_kN = t.number("check_min_load_kN", pos);

@@ -37,9 +37,10 @@ class Rng {
 struct Demand {
   std::vector<std::pair<double, double>> points{{0.0, 0.0}};
   std::vector<std::pair<double, double>> hard_stops;
+  double pace = 1.0;  // every step takes dt_s / pace
   double t() const { return points.back().first; }
   double d() const { return points.back().second; }
-  void to(double dt_s, double demand) { points.emplace_back(t() + dt_s, demand); }
+  void to(double dt_s, double demand) { points.emplace_back(t() + dt_s / pace, demand); }
   void hold(double dt_s) { to(dt_s, d()); }
 };
 
@@ -60,8 +61,9 @@ void hard_stop(Demand& m, Rng& rng, double hold_min_s, double hold_max_s) {
   m.to(rng.uniform(0.1, 0.2), rng.uniform(0.0, 0.05));
 }
 
-Demand build_profile(Profile p, Rng& rng, double duration_s) {
+Demand build_profile(Profile p, Rng& rng, double duration_s, double pace) {
   Demand m;
+  m.pace = pace;
   const double end = duration_s - 0.5;
   switch (p) {
     case Profile::City: city(m, rng, end); break;
@@ -276,7 +278,8 @@ RunPlan draw_run(const CampaignSpec& spec, int index) {
   }
   const Onset first_onset = rng.pick(spec.onsets);
   r.profile = r.fault_free ? rng.pick(spec.profiles) : profile_for(spec, first_onset, rng);
-  const Demand m = build_profile(r.profile, rng, r.duration_s);
+  r.pace = spec.pace_min < spec.pace_max ? rng.uniform(spec.pace_min, spec.pace_max) : spec.pace_min;
+  const Demand m = build_profile(r.profile, rng, r.duration_s, r.pace);
   r.demand = m.points;
   r.hard_stops = m.hard_stops;
   if (r.fault_free) return r;
@@ -307,7 +310,7 @@ std::string scenario_yaml(const CampaignSpec& spec, const RunPlan& r, const std:
   std::ostringstream o;
   o.precision(10);
   o << "# Drawn by bbw_campaign: campaign '" << spec.name << "' (seed " << spec.seed << "), run " << r.index << ", profile "
-    << to_string(r.profile) << (r.fault_free ? ", fault-free" : "") << ".\n";
+    << to_string(r.profile) << (r.pace != 1.0 ? ", pace " + std::to_string(r.pace) : std::string()) << (r.fault_free ? ", fault-free" : "") << ".\n";
   o << "name: " << spec.name << "_" << r.index << "\n";
   o << "seed: " << r.scenario_seed << "\n";
   o << "duration_s: " << r.duration_s << "\n";

@@ -24,6 +24,7 @@ struct RunPlan {
   std::uint64_t scenario_seed = 0;
   bool fault_free = true;
   Profile profile = Profile::City;
+  double pace = 1.0;                                 // the driver's pace (CampaignSpec::pace_min)
   double duration_s = 0.0;
   int member = 0;                                    // population member
   std::array<double, 4> temperature_C{};             // FL, FR, RL, RR

@@ -268,6 +268,9 @@ struct Group {
   std::string worst;  // the slowest detection or a miss, named
   double worst_latency_ms = -1.0;
   std::vector<std::string> misses;
+  std::vector<double> after_kN;    // each detected fault's estimate error after its detection
+  double worst_after_kN = -1.0;
+  std::string worst_after;         // the fault with the largest, named
 };
 
 void add(Group& g, const RunResult& r, const FaultRow& f) {
@@ -288,6 +291,15 @@ void add(Group& g, const RunResult& r, const FaultRow& f) {
   }
   g.harm_force_kN = std::max(g.harm_force_kN, f.harm_force_error_kN);
   g.harm_estimate_kN = std::max(g.harm_estimate_kN, f.harm_estimate_error_kN);
+  if (std::isfinite(f.after_estimate_error_kN)) {
+    g.after_kN.push_back(f.after_estimate_error_kN);
+    if (f.after_estimate_error_kN > g.worst_after_kN) {
+      g.worst_after_kN = f.after_estimate_error_kN;
+      char kn[32];
+      std::snprintf(kn, sizeof kn, ", %.2f kN", f.after_estimate_error_kN);
+      g.worst_after = std::string(name) + kn;
+    }
+  }
 }
 
 void group_json(json::Writer& j, const std::string& key, const Group& g) {
@@ -304,7 +316,12 @@ void group_json(json::Writer& j, const std::string& key, const Group& g) {
       .value("latency_max_ms", g.latency_ms.empty() ? std::nan("") : *std::max_element(g.latency_ms.begin(), g.latency_ms.end()))
       .value("slowest", g.worst)
       .value("harm_max_force_error_kN", g.harm_force_kN)
-      .value("harm_max_estimate_error_kN", g.harm_estimate_kN);
+      .value("harm_max_estimate_error_kN", g.harm_estimate_kN)
+      .value("after_detection_estimate_error_p50_kN", percentile(g.after_kN, 0.5))
+      .value("after_detection_estimate_error_p90_kN", percentile(g.after_kN, 0.9))
+      .value("after_detection_estimate_error_max_kN",
+             g.after_kN.empty() ? std::nan("") : *std::max_element(g.after_kN.begin(), g.after_kN.end()))
+      .value("after_detection_estimate_error_worst", g.worst_after);
   j.begin_array("misses");
   for (std::size_t i = 0; i < std::min<std::size_t>(g.misses.size(), 50); ++i) j.begin_object().value("fault", g.misses[i]).end_object();
   j.end_array();
@@ -487,7 +504,8 @@ int cmd_report(const std::string& dir) {
     << "<p>" << results.size() << " of " << spec.runs << " runs with a result (" << failed << " failed), " << all.n
     << " injected faults above the stated limits, " << fmt(ff_hours, 2) << " h of fault-free driving in " << ff_runs << " runs.</p>"
     << "<h2>Coverage and latency</h2><table><tr><th>fault type</th><th>faults</th><th>detected</th><th>coverage</th><th>95 % CI (Wilson)</th>"
-    << "<th>latency p50 / p95 / max, ms</th><th>max harm: force / estimate, kN</th><th>slowest</th></tr>";
+    << "<th>latency p50 / p95 / max, ms</th><th>max harm: force / estimate, kN</th>"
+    << "<th>estimate error after detection p50 / p90 / max, kN</th><th>slowest</th></tr>";
   auto row = [&](const std::string& name, const Group& g) {
     if (g.n == 0) return;
     const Interval w = wilson95(g.detected, g.n);
@@ -495,7 +513,10 @@ int cmd_report(const std::string& dir) {
       << " %</td><td>" << fmt(100.0 * w.lo, 2) << " - " << fmt(100.0 * w.hi, 2) << " %</td><td>" << fmt(percentile(g.latency_ms, 0.5))
       << " / " << fmt(percentile(g.latency_ms, 0.95)) << " / "
       << fmt(g.latency_ms.empty() ? std::nan("") : *std::max_element(g.latency_ms.begin(), g.latency_ms.end())) << "</td><td>"
-      << fmt(g.harm_force_kN, 2) << " / " << fmt(g.harm_estimate_kN, 2) << "</td><td>" << g.worst << "</td></tr>";
+      << fmt(g.harm_force_kN, 2) << " / " << fmt(g.harm_estimate_kN, 2) << "</td><td>" << fmt(percentile(g.after_kN, 0.5), 2) << " / "
+      << fmt(percentile(g.after_kN, 0.9), 2) << " / "
+      << fmt(g.after_kN.empty() ? std::nan("") : *std::max_element(g.after_kN.begin(), g.after_kN.end()), 2) << "</td><td>"
+      << g.worst << "</td></tr>";
   };
   for (const auto& [k, g] : by_kind) row(k, g);
   row("<b>all</b>", all);

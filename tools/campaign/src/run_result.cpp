@@ -64,7 +64,11 @@ void score_into(RunResult& r, const std::vector<faults::FaultSpec>& specs, const
     const auto& cmd = t.column("command");
     const auto& mode = t.column("force_mode");
     const auto& est = t.column("fused_kN");
+    if (o.detected) row.after_estimate_error_kN = 0.0;
     for (std::size_t k = 0; k < t.rows(); ++k) {
+      if (o.detected && time[k] > o.detected_s && std::isfinite(est[k]) && std::isfinite(truth[k])) {
+        row.after_estimate_error_kN = std::max(row.after_estimate_error_kN, std::abs(est[k] - truth[k]));
+      }
       if (time[k] < row.at_s || time[k] > until_s) continue;
       if (mode[k] > 0.5) row.harm_force_error_kN = std::max(row.harm_force_error_kN, std::abs(truth[k] - cmd[k]));
       row.harm_estimate_error_kN = std::max(row.harm_estimate_error_kN, std::abs(est[k] - truth[k]));
@@ -104,6 +108,7 @@ void save_result(const RunResult& r, const std::string& file) {
         .value("window_s", f.window_s)
         .value("harm_force_error_kN", f.harm_force_error_kN)
         .value("harm_estimate_error_kN", f.harm_estimate_error_kN)
+        .value("after_estimate_error_kN", f.after_estimate_error_kN)
         .end_object();
   }
   j.end_array();
@@ -151,6 +156,8 @@ RunResult load_result(const std::string& file) {
       row.window_s = f["window_s"].as<double>();
       row.harm_force_error_kN = f["harm_force_error_kN"].as<double>();
       row.harm_estimate_error_kN = f["harm_estimate_error_kN"].as<double>();
+      // (Absent from results written before it was measured: not measured.)
+      if (f["after_estimate_error_kN"] && !f["after_estimate_error_kN"].IsNull()) row.after_estimate_error_kN = f["after_estimate_error_kN"].as<double>();
       r.faults.push_back(row);
     }
     for (const auto& a : n["false_alarms"]) {

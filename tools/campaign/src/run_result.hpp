@@ -3,6 +3,7 @@
 // result.json atomically (a temporary file renamed), read back by the report.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,10 @@ struct FaultRow {
   // Harm while undetected (from the injection to the detection, or to the fault's end):
   double harm_force_error_kN = 0.0;     // max |true clamp force - command| on the corner
   double harm_estimate_error_kN = 0.0;  // max |CCU's force estimate - true clamp force|
+  // After the detection (to the run's end): max |CCU's force estimate - true clamp force| where
+  // the CCU has one, the estimate the reaction leaves the brake with (a lost load cell's curve, a
+  // faulty resolver's load cell). NaN when undetected, or in a result written before it existed.
+  double after_estimate_error_kN = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct FalseAlarmRow {

@@ -81,6 +81,7 @@ CampaignSpec read(config::Reader& r) {
     }
   }
   s.profiles = names_list(r, "profiles", kProfiles);
+  if (r.has("pace")) std::tie(s.pace_min, s.pace_max) = interval(r, "pace", config::Range::closed(0.25, 4.0));
   {
     config::Reader f = r.map("faults");
     s.fault_kinds = names_list(f, "kinds", kKinds);

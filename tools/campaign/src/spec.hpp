@@ -39,6 +39,11 @@ struct CampaignSpec {
   double effects_share = 0.3;            // of the corners: one plant effect switched on,
   std::vector<std::string> effects;      //   drawn from these (plant::EffectsParams' names)
   std::vector<Profile> profiles;
+  // The driver's pace (optional key `pace: [min, max]`, default [1, 1]): a run's demand profile is
+  // drawn as at pace 1, every step and hold of it taking 1/pace of the time (pace 2: ramps twice as
+  // steep, holds half as long, ABS-like modulation at 10-20 Hz). Drawn per run only when min < max,
+  // so campaigns without the key draw what they drew before it existed.
+  double pace_min = 1.0, pace_max = 1.0;
   // Faults of a faulty run.
   std::vector<FaultKind> fault_kinds;
   std::vector<Onset> onsets;

@@ -47,6 +47,10 @@ struct Stats {
   double first_fit_time_s = -1.0;      // time of the first accepted fit; -1 before it
   double last_fit_rms_kN = 0.0;        // residual RMS of the last cycle fit
   double last_fit_span_rev = 0.0;      // displacement span of the last cycle fitted
+  // The positions the curve's accepted fits had samples over (their union; lo > hi before any):
+  // elsewhere its PF points keep the initial curve's values.
+  double curve_data_min_rev = 1.0;
+  double curve_data_max_rev = 0.0;
 };
 
 // Friction part of the model: thresholds Delta_i (rev) and stiffnesses K_i (kN/rev).
@@ -87,6 +91,7 @@ class Calibrator {
  private:
   bool fits_held_ = false;
   void start_cycle(double x_rev);
+  void note_curve_data(double x_lo_rev, double x_hi_rev);  // Stats::curve_data_*
   bool end_cycle();
   template <class F>
   void for_each_fit_row(std::size_t columns, F&& f);

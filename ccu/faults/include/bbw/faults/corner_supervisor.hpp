@@ -20,6 +20,7 @@
 #include "bbw/plant/clamp_curve.hpp"
 #include "bbw/corner_unit/controller.hpp"
 #include "bbw/faults/fault_monitor.hpp"
+#include "bbw/faults/bridged_curve.hpp"
 #include "bbw/faults/last_good.hpp"
 #include "bbw/faults/sample_guard.hpp"
 
@@ -104,6 +105,8 @@ class CornerSupervisor {
   std::optional<plant::ClampCurve> eol_;  // the corner's end-of-line curve, when the scenario has one
   double fed_min_rev_ = std::numeric_limits<double>::infinity();   // positions the calibrator saw
   double fed_max_rev_ = -std::numeric_limits<double>::infinity();
+  double last_temperature_C_ = std::numeric_limits<double>::quiet_NaN();  // the last usable sample's
+  DataSpan curve_data_;  // where the curve the calibrator (re)started from had data (empty: none)
   std::uint64_t restarts_ = 0;
   std::uint64_t fed_ = 0;
 };

@@ -380,6 +380,17 @@ struct MonitorParams {
   // A dropout ends: after this many consecutive samples with a value again the load-cell finding
   // (a dropout only) clears, and the calibrator it stopped resumes from the last good curve.
   int dropout_clear_samples = 200;
+  // After a load-cell finding the corner's curve (its force feedback and the CCU's estimate) is
+  // the newest fit before the fault's onset where that fit had data and, with an end-of-line
+  // curve, that curve's rise beyond, refitted as one cubic from curve_min_rev to where the
+  // end-of-line curve reaches force_limit_kN (bridge_curve). Off: the fit itself, extrapolated
+  // (33.6 kN read at 7.7 rev on a soft caliper clamping 14.6; faster-driver campaign run 68).
+  bool lost_load_cell_curve_from_eol = true;
+  // With an end-of-line curve, the corner's calibrator starts from that caliper's own curve (a
+  // cubic over the calibrator's range at the curve's reference temperature) instead of the
+  // configured initial curve (the shipped caliper's end-of-line cubic). Its fits replace the
+  // initial curve only where their cycles had data (CornerSupervisor, `starting`).
+  bool calibrator_initial_curve_from_eol = true;
 
   // Actuator torque balance: the torque the axial load and the acceleration need,
   // load * Nm_per_kN + J 2 pi a, against the torque the measured current should make,

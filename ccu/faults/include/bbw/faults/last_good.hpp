@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bbw/calibration/calibrator.hpp"
+#include "bbw/faults/bridged_curve.hpp"
 #include "bbw/model/curve.hpp"
 
 namespace bbw::faults {
@@ -19,6 +20,7 @@ struct CalibrationSnapshot {
   calibration::Curve curve;
   std::vector<double> stiffness_kN_per_rev;  // K_i, size M (sized at construction)
   bool from_fit = false;                     // false: the configured initial curve
+  DataSpan data;                             // where the fits up to it had data (empty: none)
 };
 
 class LastGoodCalibration {
@@ -28,8 +30,8 @@ class LastGoodCalibration {
   // Starts with the calibrator's initial state (its initial curve, zero K_i) as the fallback.
   explicit LastGoodCalibration(const calibration::Calibrator& initial);
 
-  // Stores the calibrator's current curve and K_i as of time_s.
-  void push(double time_s, const calibration::Calibrator& c);
+  // Stores the calibrator's current curve and K_i as of time_s, its fits' data over `data`.
+  void push(double time_s, const calibration::Calibrator& c, const DataSpan& data);
   // The newest snapshot taken strictly before time_s (the initial state if none).
   const CalibrationSnapshot& before(double time_s) const;
   const CalibrationSnapshot& newest() const;

@@ -61,6 +61,7 @@ class SampleGuard {
   std::uint64_t rejected() const;
   std::uint64_t load_cell_missing() const { return load_cell_missing_; }
   std::uint64_t last_seq() const { return last_seq_; }
+  const GuardLimits& limits() const { return limits_; }
   double last_time_s() const { return last_time_s_; }
   bool has_accepted() const { return have_last_; }
 
