@@ -981,6 +981,30 @@ TEST(ClosedLoopIssue14, BeyondTheFitsDataTheEndOfLineCurveCarriesALostLoadCellsC
   EXPECT_GT(without.worst_kN, 5.0);
 }
 
+// A load-cell drift named in a hard stop keeps drifting (tuning seed 1401, run 62: -1.656 kN/s on
+// FR). At 16.6 s its value passes the guard's -10 kN. The CCU no longer uses it, yet every sample
+// was rejected as corrupt for it: FR unseen while its brake released, its estimate frozen at 16.6
+// kN. Now the diagnosed load cell's value out of range is no value (guard.diagnosed_load_cell_out_of_range_is_absent).
+TEST(ClosedLoopIssue14, ADiagnosedLoadCellDriftingOutOfRangeDoesNotBlindTheCcu) {
+  const auto fs = load("config/scenarios/faults/load_cell_drift_past_the_guards_range.yaml");
+  const std::size_t fr = 1;
+  auto opts = default_options();
+  const auto with = lost_load_cell_run(fs, fr, 1.5, 0, [](MonitorParams&) {});
+  const auto without = lost_load_cell_run(fs, fr, 1.5, 0, [](MonitorParams& m) { m.guard_diagnosed_load_cell_absent = false; });
+  const auto r = run_closed_loop(fs, opts);
+  opts.monitor.guard_diagnosed_load_cell_absent = false;
+  const auto base = run_closed_loop(fs, opts);
+  std::printf("FR's estimate after its drift was named, worst |estimate - clamp force|: %.2f kN (at %.2f s) with the rule, "
+              "%.2f (%.2f s) without; samples rejected %llu and %llu\n",
+              with.worst_kN, with.worst_at_s, without.worst_kN, without.worst_at_s,
+              static_cast<unsigned long long>(r.guard_rejected[fr]), static_cast<unsigned long long>(base.guard_rejected[fr]));
+  EXPECT_LT(with.worst_kN, 1.0);
+  EXPECT_TRUE(with.only_its_faults);
+  EXPECT_EQ(r.guard_rejected[fr], 0u);
+  EXPECT_GT(without.worst_kN, 10.0);
+  EXPECT_GT(base.guard_rejected[fr], 100u);
+}
+
 // A hold's reference is set only from settle samples that lie within hold.settled_within_kN of
 // each other (soft10_ff run 2): FL's 5 ms load-cell lag after its wide keys reversed made the
 // residual fall 1.3 kN across the settle samples; their mean, taken as the hold's level, named

@@ -167,6 +167,26 @@ TEST(SampleGuard, ClassifiesAndCountsEveryKindOfCorruptSample) {
   EXPECT_EQ(g.check(at(4000000, 31.0)).issue, SampleIssue::Jump);
 }
 
+// A load cell the CCU has named faulty: its value out of range (or infinite) is no value, and the
+// sample still counts (a drift past -10 kN; tuning seed 1401 run 62). Not named: corrupt.
+TEST(SampleGuard, ADiagnosedLoadCellOutOfRangeIsAbsentNotCorrupt) {
+  SampleGuard g(GuardLimits{});
+  EXPECT_TRUE(g.check(at(1, 0.001)).usable());
+  EXPECT_EQ(g.check(at(2, 0.002, 2.0, -13.5)).issue, SampleIssue::OutOfRange);
+  const auto c = g.check(at(2, 0.002, 2.0, -13.5), true);
+  EXPECT_TRUE(c.usable());
+  EXPECT_FALSE(c.load_cell_present);
+  const auto i = g.check(at(3, 0.003, 2.0, std::numeric_limits<double>::infinity()), true);
+  EXPECT_TRUE(i.usable());
+  EXPECT_FALSE(i.load_cell_present);
+  EXPECT_TRUE(g.check(at(4, 0.004, 2.0, 5.0), true).load_cell_present);  // in range: a value
+  EXPECT_EQ(g.load_cell_ignored(), 2u);
+  EXPECT_EQ(g.load_cell_missing(), 0u);
+  EXPECT_EQ(g.rejected(), 1u);
+  // The rest of the sample is still checked.
+  EXPECT_EQ(g.check(at(5, 0.005, 42.0, -13.5), true).issue, SampleIssue::OutOfRange);
+}
+
 TEST(FaultMonitor, DefaultParametersAreValidAndInvalidOnesNameTheField) {
   EXPECT_NO_THROW(MonitorParams{}.validate());
   MonitorParams p;

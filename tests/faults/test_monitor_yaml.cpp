@@ -44,7 +44,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
 #define SAME(f) EXPECT_EQ(y.f, d.f) << #f
   SAME(guard.position_min_rev); SAME(guard.position_max_rev); SAME(guard.speed_abs_max_rev_per_s);
   SAME(guard.load_cell_min_kN); SAME(guard.load_cell_max_kN); SAME(guard.current_abs_max_A);
-  SAME(guard.max_sequence_jump); SAME(guard.max_time_jump_s); SAME(guard_position_from_eol);
+  SAME(guard.max_sequence_jump); SAME(guard.max_time_jump_s); SAME(guard_position_from_eol); SAME(guard_diagnosed_load_cell_absent);
   SAME(lost_load_cell_curve_from_eol); SAME(calibrator_initial_curve_from_eol);
   SAME(residual_threshold_kN); SAME(uncalibrated_residual_threshold_kN); SAME(residual_persist_s);
   SAME(residual_reference_s); SAME(residual_change_threshold_kN); SAME(curve_min_rev); SAME(curve_max_rev);

@@ -75,7 +75,7 @@ TEST(FaultSchedule, EveryCampaignFileLoadsAndTogetherTheyCoverEveryType) {
       types.insert(fs.faults.faults[0].type);
     }
   }
-  EXPECT_EQ(files, 57u);  // soft calipers' load cells lost in hard stops beyond the calibrator's range (after a fit and before one); two fault-free drives of calipers ten times softer (back from beyond the guard's 10 rev; a hold after a delayed key reversal) and one ten times stiffer (a motor creeping inside the play); a viscous caliper's fast reversal, fault-free and with a load-cell bias, and a drift in its fast apply; a drive seized in a hard stop beside a healthy corner whose wide keys pull its load cell below 0;
+  EXPECT_EQ(files, 58u);  // a load-cell drift past the guard's range after its finding; soft calipers' load cells lost in hard stops beyond the calibrator's range (after a fit and before one); two fault-free drives of calipers ten times softer (back from beyond the guard's 10 rev; a hold after a delayed key reversal) and one ten times stiffer (a motor creeping inside the play); a viscous caliper's fast reversal, fault-free and with a load-cell bias, and a drift in its fast apply; a drive seized in a hard stop beside a healthy corner whose wide keys pull its load cell below 0;
                           // three fault-free drives of the extreme population with the plant's newer effects (keys holding friction
                           // at the released position, a slow reversal below the trusted range, a noisy load cell released); calipers with pad creep, load-dependent friction, a hot load cell's thermal drift: fault-free, and with a
                           // load-cell bias in a hard stop; actuator_seized three times: at a peak, in a hold, in a hot hard stop; load_cell bias four

@@ -162,7 +162,8 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
   // process goes on, and a sample numbered back is still not its (a hostile writer's, in a
   // realtime run whose FL link was lost under load: accepted, it went back in sequence).
   if (was_lost) guard_.rejoin(!monitor_.ok(Part::Process));
-  const SampleCheck check = guard_.check(r);
+  const SampleCheck check =
+      guard_.check(r, monitor_.params().guard_diagnosed_load_cell_absent && !monitor_.ok(Part::LoadCell));
   if (check.usable() && std::isfinite(r.temperature_C)) last_temperature_C_ = r.temperature_C;
   // Usable again after samples the guard rejected (a position beyond its range): the positions
   // between went unseen, so the calibrator's friction states and its cycle did not survive the

@@ -20,6 +20,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.guard.max_sequence_jump = g.number("max_sequence_jump", Range::at_least(1.0));
   p.guard.max_time_jump_s = g.number("max_time_jump_s", pos);
   p.guard_position_from_eol = g.boolean("position_from_end_of_line");
+  p.guard_diagnosed_load_cell_absent = g.boolean("diagnosed_load_cell_out_of_range_is_absent");
   g.finish();
 
   auto res = r.map("residual");

@@ -55,9 +55,12 @@ void SampleGuard::rejoin(bool sequence_restarts) {
   if (sequence_restarts) seq_continuity_ = false;
 }
 
-SampleCheck SampleGuard::check(const CornerReading& r) {
+SampleCheck SampleGuard::check(const CornerReading& r, bool load_cell_diagnosed) {
   SampleCheck c;
-  const bool lc_nan = std::isnan(r.force_kN);
+  const bool lc_ignored = load_cell_diagnosed && !std::isnan(r.force_kN) &&
+                          (!std::isfinite(r.force_kN) || r.force_kN < limits_.load_cell_min_kN ||
+                           r.force_kN > limits_.load_cell_max_kN);
+  const bool lc_nan = std::isnan(r.force_kN) || lc_ignored;  // (absent either way)
   const bool cmd_ok = std::isnan(r.force_command_kN) || std::isfinite(r.force_command_kN);
   if (!std::isfinite(r.time_s) || !std::isfinite(r.position_rev) || !std::isfinite(r.speed_rev_per_s) ||
       !std::isfinite(r.motor_current_A) || (!lc_nan && !std::isfinite(r.force_kN)) || !cmd_ok) {
@@ -89,7 +92,11 @@ SampleCheck SampleGuard::check(const CornerReading& r) {
   last_seq_ = r.seq;
   last_time_s_ = r.time_s;
   c.load_cell_present = !lc_nan;
-  if (lc_nan) ++load_cell_missing_;
+  if (lc_ignored) {
+    ++load_cell_ignored_;
+  } else if (lc_nan) {
+    ++load_cell_missing_;
+  }
   return c;
 }
 

@@ -46,6 +46,10 @@ struct MonitorParams {
   // the shipped one needs 11-12 rev for 16-20 kN, and the guard rejected every sample up there as
   // corrupt (soft10 campaigns: faults in hard stops unseen, healthy samples counted as corrupt).
   bool guard_position_from_eol = true;
+  // Once the load cell is named faulty, its value out of the guard's range makes that channel
+  // absent rather than the sample corrupt (SampleGuard::check's load_cell_diagnosed). Off: a
+  // drifting load cell past -10 kN made every later sample corrupt.
+  bool guard_diagnosed_load_cell_absent = true;
 
   // Analytic redundancy: r = (load cell - friction estimate) - curve(position).
   double residual_threshold_kN = 0.6;               // once the calibrator has an accepted fit

@@ -49,7 +49,12 @@ class SampleGuard {
  public:
   explicit SampleGuard(const GuardLimits& limits);  // throws std::invalid_argument
 
-  SampleCheck check(const CornerReading& r);
+  // load_cell_diagnosed: the CCU has named this corner's load cell faulty and no longer uses it.
+  // Its value out of range (or infinite) then makes the load-cell channel absent, not the sample
+  // corrupt: the position, speed and current still count (a drifting load cell at -13 kN made
+  // every sample of a releasing brake corrupt, its estimate frozen at 16.6 kN; tuning seed 1401
+  // run 62). Counted apart (load_cell_ignored).
+  SampleCheck check(const CornerReading& r, bool load_cell_diagnosed = false);
   // The corner is back after it was lost. A new incarnation (a restarted process,
   // sequence_restarts): its sequence may start again. The same process after a lost link: its
   // sequence goes on, so it may not go back nor repeat, but it may jump ahead (the samples of the
@@ -60,6 +65,8 @@ class SampleGuard {
   std::uint64_t count(SampleIssue i) const { return counts_[static_cast<std::size_t>(i)]; }
   std::uint64_t rejected() const;
   std::uint64_t load_cell_missing() const { return load_cell_missing_; }
+  // Samples of a diagnosed load cell whose value was out of range or infinite (check()).
+  std::uint64_t load_cell_ignored() const { return load_cell_ignored_; }
   std::uint64_t last_seq() const { return last_seq_; }
   const GuardLimits& limits() const { return limits_; }
   double last_time_s() const { return last_time_s_; }
@@ -74,6 +81,7 @@ class SampleGuard {
   double last_time_s_ = 0.0;
   std::array<std::uint64_t, kSampleIssueCount> counts_{};
   std::uint64_t load_cell_missing_ = 0;
+  std::uint64_t load_cell_ignored_ = 0;
 };
 
 }  // namespace bbw::faults
