@@ -694,6 +694,7 @@ void CcuApp::write_stats(const std::string& file) const {
     c.deadlines_missed = ch.deadlines_missed;
     c.liveliness_lost = ch.liveliness_lost;
     c.guard_rejected = sup.guard().rejected();
+    c.load_cell_ignored = sup.guard().load_cell_ignored();
     c.calibrator_restarts = sup.calibrator_restarts();
     c.fits_accepted = st.fits_accepted;
     c.fits_rejected = st.fits_rejected;

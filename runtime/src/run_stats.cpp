@@ -48,6 +48,7 @@ void ccu_corner_fields(S& s, F&& f) {
   f("deadlines_missed", s.deadlines_missed);
   f("liveliness_lost", s.liveliness_lost);
   f("guard_rejected", s.guard_rejected);
+  f("load_cell_ignored", s.load_cell_ignored);
   f("calibrator_restarts", s.calibrator_restarts);
   f("fits_accepted", s.fits_accepted);
   f("fits_rejected", s.fits_rejected);

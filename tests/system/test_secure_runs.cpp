@@ -343,15 +343,22 @@ TEST(SystemHostileInput, MalformedMeasurementsAreRejectedAndCounted) {
   // Every sample the CCU logged for FL: a bad value is never valid; valid samples move forward.
   const Table t = read_table(out + "/ccu_FL.csv");
   ASSERT_GT(t.rows.size(), 100u);
-  std::size_t bad = 0, bad_accepted = 0, backwards_accepted = 0;
+  std::size_t bad = 0, bad_accepted = 0, backwards_accepted = 0, load_cell_ignored = 0;
   double last_seq = -1.0, last_time = -1e300;
   std::string backwards;  // the first few, with the accepted sample before each
   for (std::size_t i = 0; i < t.rows.size(); ++i) {
     const double x = t.at(i, "position_rev"), f = t.at(i, "force_internal_kN");
-    const bool is_bad = !std::isfinite(x) || std::isinf(f) || x > 10.0 || x < -1.0 || f > 80.0;
+    const bool bad_rest = !std::isfinite(x) || x > 10.0 || x < -1.0;
+    const bool bad_load_cell = std::isinf(f) || f > 80.0 || f < -10.0;
     const bool accepted = t.at(i, "accepted") == 1.0;  // let through by the CCU's sample guard
-    if (is_bad) ++bad;
-    if (is_bad && accepted) ++bad_accepted;
+    // Once the CCU has named FL's load cell faulty, a load-cell value out of range is no value
+    // (guard.diagnosed_load_cell_out_of_range_is_absent): the rest of the sample may be kept, and
+    // the estimate then comes from the curve (source 2) or none (0), never from that load cell.
+    const double source = t.at(i, "source");
+    const bool load_cell_unused = source == 0.0 || source == 2.0;
+    if (bad_rest || bad_load_cell) ++bad;
+    if (accepted && (bad_rest || (bad_load_cell && !load_cell_unused))) ++bad_accepted;
+    if (accepted && !bad_rest && bad_load_cell && load_cell_unused) ++load_cell_ignored;
     if (accepted) {
       if (!(t.at(i, "seq") > last_seq) || !(t.at(i, "time_s") > last_time)) {
         if (++backwards_accepted <= 3) {
@@ -366,6 +373,7 @@ TEST(SystemHostileInput, MalformedMeasurementsAreRejectedAndCounted) {
   }
   EXPECT_GT(bad, 0u) << "no malformed sample reached the CCU: the test proves nothing";
   EXPECT_EQ(bad_accepted, 0u) << "malformed samples were accepted";
+  EXPECT_EQ(static_cast<double>(load_cell_ignored), stat(ccu, "FL.load_cell_ignored"));
   EXPECT_EQ(backwards_accepted, 0u) << "an accepted sample went backwards in sequence or time:\n"
                                     << backwards << "FL rejoins " << stat(ccu, "FL.rejoins") << "\n" << r.err;
   fs::remove_all(dir);

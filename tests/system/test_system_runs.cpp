@@ -19,6 +19,8 @@
 #include "bbw/calibration/config_yaml.hpp"
 #include "bbw/calibration/offline.hpp"
 #include "bbw/common/csv.hpp"
+#include "bbw/faults/corner_supervisor.hpp"
+#include "bbw/scenario/load.hpp"
 #include "bbw/runtime/child.hpp"
 #include "bbw/runtime/run_stats.hpp"
 #include "bbw/runtime/stats_file.hpp"
@@ -143,7 +145,24 @@ TEST(SystemLockstep, CcuEstimatesEqualOfflineCalibration) {
   const std::string dir = scratch("offline");
   const ProcessRun r = launch("tests/system/data/short_rig.yaml", dir, 163, "lockstep");
   ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.err;
-  const auto config = bbw::calibration::load_config(src("config/calibrator/robust.yaml"));
+  // The CCU starts each calibrator from its caliper's end-of-line curve (the scenario's plant
+  // curve; calibrator_start.initial_curve_from_end_of_line): offline starts from the same.
+  bbw::faults::MonitorParams eol;
+  eol.eol_curve = bbw::scenario::load_scenario(src("tests/system/data/short_rig.yaml")).plant.curve;
+  const auto config = bbw::faults::calibrator_start(bbw::calibration::load_config(src("config/calibrator/robust.yaml")), eol);
+  // The same for ./bbw calibrate: the configured file with that initial curve (at full precision).
+  std::string config_text = slurp(src("config/calibrator/robust.yaml"));
+  {
+    const auto at = config_text.find("initial_curve:");
+    const auto end = config_text.find("accept:", at);
+    ASSERT_TRUE(at != std::string::npos && end != std::string::npos);
+    char curve[256];
+    std::snprintf(curve, sizeof curve, "initial_curve:\n  a_kN_per_rev3: %.17g\n  b_kN_per_rev2: %.17g\n  c_kN_per_rev: %.17g\n  d_kN: %.17g\n",
+                  config.initial_curve.a, config.initial_curve.b, config.initial_curve.c, config.initial_curve.d);
+    config_text.replace(at, end - at, curve);
+  }
+  const std::string config_file = dir + "/robust_from_end_of_line.yaml";
+  std::ofstream(config_file) << config_text;
   for (const char* c : {"FL", "RR"}) {
     bbw::csv::ReadOptions o;
     o.required = {"time_s", "position_rev", "force_internal_kN", "estimate_kN", "friction_kN", "curve_kN"};
@@ -170,7 +189,7 @@ TEST(SystemLockstep, CcuEstimatesEqualOfflineCalibration) {
     // And the command-line tool on the same recording agrees at its output precision.
     const std::string cal_dir = dir + "/calibrate_" + c;
     const ProcessRun cal = run("bbw_calibrate", {bin("bbw_calibrate"), "--input", dir + "/out/ccu_" + std::string(c) + ".csv",
-                                          "--out", cal_dir, "--truth", "force_true_kN"},
+                                          "--config", config_file, "--out", cal_dir, "--truth", "force_true_kN"},
                         dir + "/cal_" + c, 60s);
     ASSERT_TRUE(cal.status.ok()) << cal.err;
     bbw::csv::ReadOptions oo;

@@ -44,12 +44,14 @@ calibration::CalibratorConfig accepting(calibration::CalibratorConfig c, const M
   return c;
 }
 
+}  // namespace
+
 // The calibrator's starting curve: with an end-of-line curve (and calibrator_start.initial_curve_
 // from_end_of_line), that caliper's own, as a cubic over the calibrator's range at its reference
 // temperature; the configured one (the shipped caliper's) otherwise. Its fits replace it only
 // where their cycles had data: elsewhere a caliper 0.4 x as stiff kept the shipped caliper's
 // forces, 5-8 kN where it clamped 1 (faster-driver campaign run 68).
-calibration::CalibratorConfig starting(calibration::CalibratorConfig c, const MonitorParams& m) {
+calibration::CalibratorConfig calibrator_start(calibration::CalibratorConfig c, const MonitorParams& m) {
   // (An empty range is the calibrator's to refuse, with its own message.)
   if (!m.calibrator_initial_curve_from_eol || !m.eol_curve || !(c.x_max_rev > c.x_min_rev)) return c;
   const plant::ClampCurve eol(*m.eol_curve);
@@ -57,8 +59,6 @@ calibration::CalibratorConfig starting(calibration::CalibratorConfig c, const Mo
                                  c.x_max_rev);
   return c;
 }
-
-}  // namespace
 
 const char* to_string(EstimateSource s) {
   switch (s) {
@@ -76,7 +76,7 @@ CornerSupervisor::CornerSupervisor(const calibration::CalibratorConfig& calibrat
 
 CornerSupervisor::CornerSupervisor(const calibration::CalibratorConfig& calibrator, const MonitorParams& monitor,
                                    Target corner, const GuardLimits& guard)
-    : config_(accepting(starting(calibrator, monitor), monitor, guard)),
+    : config_(accepting(calibrator_start(calibrator, monitor), monitor, guard)),
       corner_(corner),
       guard_(guard),
       calibrator_(std::in_place, config_),

@@ -26,6 +26,7 @@ struct CcuCornerStats {
   std::uint64_t deadlines_missed = 0;
   std::uint64_t liveliness_lost = 0;
   std::uint64_t guard_rejected = 0;
+  std::uint64_t load_cell_ignored = 0;  // a diagnosed load cell's values out of range: absent, the samples kept
   std::uint64_t calibrator_restarts = 0;
   std::uint64_t fits_accepted = 0;
   std::uint64_t fits_rejected = 0;

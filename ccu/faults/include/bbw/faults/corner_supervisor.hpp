@@ -48,6 +48,12 @@ struct CornerView {
   bool estimate_valid() const { return source != EstimateSource::None; }
 };
 
+// The calibrator config a corner's calibrator starts from: `c` with, when `m` has an end-of-line
+// curve and calibrator_initial_curve_from_eol, that caliper's own curve as its initial curve (a
+// cubic over c's range at the curve's reference temperature). Offline calibration that should
+// match a CCU's starts from the same (SystemLockstep.CcuEstimatesEqualOfflineCalibration).
+calibration::CalibratorConfig calibrator_start(calibration::CalibratorConfig c, const MonitorParams& m);
+
 class CornerSupervisor {
  public:
   // Throws std::invalid_argument for invalid configs or Target::CCU.
