@@ -393,7 +393,7 @@ struct MonitorParams {
   // With an end-of-line curve, the corner's calibrator starts from that caliper's own curve (a
   // cubic over the calibrator's range at the curve's reference temperature) instead of the
   // configured initial curve (the shipped caliper's end-of-line cubic). Its fits replace the
-  // initial curve only where their cycles had data (CornerSupervisor, `starting`).
+  // initial curve only where their cycles had data (calibrator_start in corner_supervisor.hpp).
   bool calibrator_initial_curve_from_eol = true;
 
   // Actuator torque balance: the torque the axial load and the acceleration need,
