@@ -1,5 +1,5 @@
-// The curve a corner is left with when its load cell is lost (docs/faults.md, "The curve a lost
-// load cell leaves"): the newest fit before the fault where that fit had data, the caliper's
+// The curve a corner is left with when its load cell is lost (docs/faults.md, "Reaction" and
+// "Twenty-ninth session"): the newest fit before the fault where that fit had data, the caliper's
 // end-of-line curve's shape beyond. Pure; no allocation.
 #pragma once
 
