@@ -126,7 +126,7 @@ void CornerSupervisor::restart_calibrator() {
   cfg.initial_curve = good.curve;
   calibrator_.emplace(cfg);
   calibrator_->set_friction_stiffness(good.stiffness_kN_per_rev);
-  curve_data_ = good.data;
+  calibrator_->note_prior_curve_data(good.data.lo_rev, good.data.hi_rev);
   fusion_.reset();
   last_fed_time_s_ = std::numeric_limits<double>::quiet_NaN();
   ++restarts_;
@@ -210,14 +210,9 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
   if (fed != nullptr && e.valid) {
     if (e.fit_accepted && monitor_.ok(Part::LoadCell) && monitor_.ok(Part::Resolver)) {
       // Where its curve had data: its own accepted fits' and, after a restart, the snapshot's it
-      // started from.
+      // started from (Calibrator::note_prior_curve_data).
       const calibration::Stats& st = calibrator_->stats();
-      DataSpan data{st.curve_data_min_rev, st.curve_data_max_rev};
-      if (data.empty()) {
-        data = curve_data_;
-      } else if (!curve_data_.empty()) {
-        data = DataSpan{std::min(data.lo_rev, curve_data_.lo_rev), std::max(data.hi_rev, curve_data_.hi_rev)};
-      }
+      const DataSpan data{st.curve_data_min_rev, st.curve_data_max_rev};
       last_good_.push(r.time_s, *calibrator_, data);
       monitor_.set_curve_range(fed_min_rev_, fed_max_rev_);  // the fits had data here
       monitor_.set_fit_rms(calibrator_->stats().last_fit_rms_kN);  // its model uncertainty

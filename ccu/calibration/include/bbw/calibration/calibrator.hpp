@@ -79,6 +79,9 @@ class Calibrator {
   void reset_curve(const Curve& curve);
   // Friction stiffnesses from elsewhere (e.g. the last good state); sizes must match M.
   void set_friction_stiffness(const std::vector<double>& k_kN_per_rev);
+  // Where the current curve already had data before this calibrator (a restart from a snapshot):
+  // joined into Stats::curve_data_* as an accepted fit's span is. Ignored when empty (lo > hi).
+  void note_prior_curve_data(double lo_rev, double hi_rev) { note_curve_data(lo_rev, hi_rev); }
 
   // While held, a cycle that ends is not fitted (counted in Stats::fits_held) and a new cycle
   // starts as usual: the CCU holds fits while its fault monitor suspects the load cell, so a

@@ -112,7 +112,6 @@ class CornerSupervisor {
   double fed_min_rev_ = std::numeric_limits<double>::infinity();   // positions the calibrator saw
   double fed_max_rev_ = -std::numeric_limits<double>::infinity();
   double last_temperature_C_ = std::numeric_limits<double>::quiet_NaN();  // the last usable sample's
-  DataSpan curve_data_;  // where the curve the calibrator (re)started from had data (empty: none)
   std::uint64_t restarts_ = 0;
   std::uint64_t fed_ = 0;
 };
