@@ -165,6 +165,33 @@ TEST(Calibrator, BacklashTermRunsTheModelOnTheSpindlePosition) {
   EXPECT_NEAR(plain.update({0.001, 1.19, 5.0}).curve_force_kN, 11.9, 1e-12);
 }
 
+// A calibrator restarted with fitted stiffnesses (a corner's last good snapshot) reports its
+// friction as fitted once every element's state is known (the position swept 2 Delta_max), not
+// before; one given stiffnesses that were not fitted does not, until a fit of its own.
+TEST(Calibrator, RestartedWithFittedStiffnessesItsFrictionIsFittedOnceItsStatesAreKnown) {
+  const auto c = base_config(Mode::Robust);
+  Calibrator restarted(c), unfitted(c);
+  const std::vector<double> k(6, 2.0);
+  restarted.set_friction_stiffness(k, true);
+  unfitted.set_friction_stiffness(k);
+  int j = 1;
+  for (; j <= 50; ++j) {  // 2 rev up by 0.5 * 2 Delta_max: not yet swept
+    const double x = 2.0 + 0.003 * j;
+    EXPECT_FALSE(restarted.update({0.001 * j, x, 10.0}).friction_fitted) << "x " << x;
+  }
+  bool fitted_seen = false;
+  for (; j <= 400; ++j) {  // on up, past 2 Delta_max = 0.6 rev
+    const double x = 2.0 + 0.003 * j;
+    const Estimate e = restarted.update({0.001 * j, x, 10.0});
+    const Estimate u = unfitted.update({0.001 * j, x, 10.0});
+    EXPECT_FALSE(e.calibrated);
+    EXPECT_FALSE(u.friction_fitted);
+    fitted_seen = fitted_seen || e.friction_fitted;
+    if (x >= 2.0 + 2.0 * c.delta_max_rev + 0.01) EXPECT_TRUE(e.friction_fitted) << "x " << x;
+  }
+  EXPECT_TRUE(fitted_seen);
+}
+
 // Load-dependent friction term: with the same stiffnesses, the friction estimate is the plain
 // one times 1 + g max(C(x), 0) / F_ref, C the current curve.
 TEST(Calibrator, LoadFrictionTermScalesTheFrictionWithTheCurveForce) {

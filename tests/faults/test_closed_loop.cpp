@@ -1003,6 +1003,90 @@ TEST(ClosedLoopIssue14, ADiagnosedLoadCellDriftingOutOfRangeDoesNotBlindTheCcu) 
   EXPECT_GT(without.guard_rejected, 100u);
 }
 
+namespace {
+
+// The worst |estimate - clamp force| of a corner over [from_s, to_s].
+double worst_estimate_error_kN(const LoopResult& r, std::size_t corner, double from_s, double to_s) {
+  double worst = 0.0;
+  for (const auto& p : r.periods) {
+    if (p.time_s < from_s || p.time_s > to_s || !std::isfinite(p.true_kN[corner]) || !std::isfinite(p.estimate_kN[corner])) continue;
+    worst = std::max(worst, std::abs(p.estimate_kN[corner] - p.true_kN[corner]));
+  }
+  return worst;
+}
+
+}  // namespace
+
+// A corner back from a lost link (faster-driver campaign run 27: a 0.76 s silence) or from a
+// resolver named stuck (run 377) restarts its calibrator from the last good curve and friction
+// stiffnesses. In the slow release that follows, keys 3.7 kN wide hold the clamp force 3-3.3 kN
+// above the command, as they should. The tracking rules counted the calibrator's friction only
+// after a fit of the restarted calibrator's own: until then the keys' friction was a brake holding
+// force, and the healthy actuator was named actuator_not_releasing. Now the restarted calibrator's
+// friction counts once its states are known again (tracking.friction_after_restart).
+TEST(ClosedLoopIssue14, ARestartedCalibratorsFrictionCountsOnceItsStatesAreKnownAgain) {
+  struct Case {
+    const char* scenario;
+    std::size_t corner;
+  };
+  for (const Case c : {Case{"config/scenarios/faults/viscous_keys_slow_release_after_a_link_silence.yaml", 3},
+                       Case{"config/scenarios/faults/keys_slow_release_after_a_stuck_resolver_cleared.yaml", 2}}) {
+    const auto fs = load(c.scenario);
+    const auto r = run_closed_loop(fs, default_options());
+    ASSERT_EQ(r.outcomes.size(), 1u) << c.scenario;
+    EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << c.scenario << ": " << to_string(r.outcomes[0].diagnosis);
+    EXPECT_EQ(r.faults_raised(), 1u) << c.scenario;
+    EXPECT_FALSE(actuator(r, c.corner).present) << c.scenario << ": " << to_string(actuator(r, c.corner).finding);
+    auto opts = default_options();
+    opts.monitor.tracking_friction_after_restart = false;
+    const auto base = run_closed_loop(fs, opts);
+    EXPECT_EQ(actuator(base, c.corner).finding, Finding::ActuatorNotReleasing)
+        << c.scenario << ": without the rule " << to_string(actuator(base, c.corner).finding);
+    std::printf("%s: %zu findings with the restarted calibrator's friction, %zu without (%s at %.3f s)\n", c.scenario,
+                r.faults_raised(), base.faults_raised(), to_string(actuator(base, c.corner).finding),
+                actuator(base, c.corner).detected_s);
+  }
+}
+
+// A resolver offset on RL in a 10 kN hold, keys 3.7 kN wide (faster-driver campaign run 55). The
+// jump swung the calibrator's friction states from +3.8 to -4.9 kN before the offset was named;
+// the estimate after the finding is the load cell less the friction frozen then. Frozen at the
+// confirming sample it stood 6.4 kN above the clamp force, and the healthy actuator was named
+// actuator_not_releasing; frozen from before the onset (resolver_lost.friction_from_before_onset)
+// it is right, and the tracking rules count that friction as they count the calibrator's
+// (resolver_lost.tracking_counts_friction): without that, the keys holding the clamp force 2.7 kN
+// below the 10 kN command were named actuator_tracking.
+TEST(ClosedLoopIssue14, AResolverFindingFreezesTheFrictionFromBeforeItsOnset) {
+  const auto fs = load("config/scenarios/faults/resolver_offset_in_a_hold_of_wide_keys.yaml");
+  const std::size_t rl = 2;
+  const double named_s = 4.39, back_s = 6.1;  // the offset named; the resolver right again at 6.148 s
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << to_string(r.outcomes[0].diagnosis);
+  EXPECT_EQ(r.faults_raised(), 1u);
+  const double with_kN = worst_estimate_error_kN(r, rl, named_s, back_s);
+  EXPECT_LT(with_kN, 1.5);
+  // Frozen at the finding: the estimate is off by the jump's swing (the tracking rules, counting
+  // the same wrong friction, judge the load cell and name nothing).
+  auto opts = default_options();
+  opts.monitor.lost_resolver_friction_before_onset = false;
+  const auto at_finding = run_closed_loop(fs, opts);
+  const double at_finding_kN = worst_estimate_error_kN(at_finding, rl, named_s, back_s);
+  EXPECT_GT(at_finding_kN, 5.0);
+  // ... and without either rule (the campaign's run), the healthy actuator is named.
+  opts.monitor.lost_resolver_tracking_counts_friction = false;
+  const auto neither = run_closed_loop(fs, opts);
+  EXPECT_EQ(actuator(neither, rl).finding, Finding::ActuatorNotReleasing) << to_string(actuator(neither, rl).finding);
+  // The friction from before the onset, uncounted: the keys' part of the shortfall is the actuator's.
+  opts = default_options();
+  opts.monitor.lost_resolver_tracking_counts_friction = false;
+  const auto uncounted = run_closed_loop(fs, opts);
+  EXPECT_EQ(actuator(uncounted, rl).finding, Finding::ActuatorTracking) << to_string(actuator(uncounted, rl).finding);
+  std::printf("RL after its resolver offset was named: worst |estimate - clamp force| %.2f kN with the friction from "
+              "before the onset, %.2f kN frozen at the finding; without either rule %s, the friction uncounted %s\n",
+              with_kN, at_finding_kN, to_string(actuator(neither, rl).finding), to_string(actuator(uncounted, rl).finding));
+}
+
 // A hold's reference is set only from settle samples that lie within hold.settled_within_kN of
 // each other (soft10_ff run 2): FL's 5 ms load-cell lag after its wide keys reversed made the
 // residual fall 1.3 kN across the settle samples; their mean, taken as the hold's level, named

@@ -88,6 +88,7 @@ bbw::calibration::Estimate fitted(bool calibrated, double lc_kN, double friction
   bbw::calibration::Estimate e;
   e.valid = true;
   e.calibrated = calibrated;
+  e.friction_fitted = calibrated;  // a calibrator's own fits: its states are known
   e.friction_kN = friction_kN;
   e.force_kN = lc_kN - friction_kN;
   e.curve_force_kN = curve_kN;
@@ -722,6 +723,29 @@ TEST(FaultMonitor, AnExcessTheCalibratedKeyFrictionExplainsIsNotABrakeThatDoesNo
   const Diagnosis uncalibrated = run(6.5, false);
   ASSERT_TRUE(uncalibrated.present);
   EXPECT_EQ(uncalibrated.finding, Finding::ActuatorNotReleasing);
+}
+
+// A restarted calibrator (a corner back from a lost link) has the fitted K_i of the snapshot it
+// restarted from before a fit of its own: once its states are known (Estimate::friction_fitted),
+// its friction counts (tracking.friction_after_restart); without the rule, only after its own fit.
+TEST(FaultMonitor, ARestartedCalibratorsFittedFrictionExplainsAnExcess) {
+  MonitorParams p = noiseless();
+  SampleCheck ok;
+  auto run = [&](bool friction_fitted) {
+    FaultMonitor m(p, Target::FL);
+    for (int k = 1; k <= 800; ++k) {
+      auto r = at(k, 0.001 * k, 4.0, k == 1 ? 10.0 : 6.5);
+      r.force_command_kN = k == 1 ? 10.0 : 6.5;  // the load cell at the command, the keys holding 3.5 kN
+      auto e = fitted(false, r.force_kN, r.force_kN - 10.0, 10.0);
+      e.friction_fitted = friction_fitted;
+      m.update(r, ok, &e, e.force_kN, r.time_s);
+    }
+    return m.diagnosis(Part::Actuator);
+  };
+  EXPECT_FALSE(run(true).present);
+  EXPECT_EQ(run(false).finding, Finding::ActuatorNotReleasing);  // its states not known yet
+  p.tracking_friction_after_restart = false;
+  EXPECT_EQ(run(true).finding, Finding::ActuatorNotReleasing);
 }
 
 // A part's finding is upgraded to not releasing (and finding_s records when); the first

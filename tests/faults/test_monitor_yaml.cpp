@@ -45,7 +45,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(guard.position_min_rev); SAME(guard.position_max_rev); SAME(guard.speed_abs_max_rev_per_s);
   SAME(guard.load_cell_min_kN); SAME(guard.load_cell_max_kN); SAME(guard.current_abs_max_A);
   SAME(guard.max_sequence_jump); SAME(guard.max_time_jump_s); SAME(guard_position_from_eol); SAME(guard_diagnosed_load_cell_absent);
-  SAME(lost_load_cell_curve_from_eol); SAME(calibrator_initial_curve_from_eol);
+  SAME(lost_load_cell_curve_from_eol); SAME(calibrator_initial_curve_from_eol); SAME(lost_resolver_friction_before_onset); SAME(lost_resolver_tracking_counts_friction);
   SAME(residual_threshold_kN); SAME(uncalibrated_residual_threshold_kN); SAME(residual_persist_s);
   SAME(residual_reference_s); SAME(residual_change_threshold_kN); SAME(curve_min_rev); SAME(curve_max_rev);
   SAME(residual_on_profile_corners); SAME(residual_findings); SAME(residual_low_upper_bound); SAME(residual_low_lower_bound); SAME(residual_low_static_span_rev);
@@ -63,6 +63,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(test_pulse_lost_mean_ratio); SAME(test_pulse_crossing_extremes); SAME(test_pulse_rescaled_after_loss); SAME(test_pulse_weak_count); SAME(test_pulse_weak_fraction);
   SAME(test_pulse_healthy_ratio); SAME(test_pulse_learn_count);
   SAME(tracking_time_constant_s); SAME(tracking_threshold_kN); SAME(tracking_relative); SAME(tracking_persist_s); SAME(tracking_excess_position_bound); SAME(tracking_shortfall_position_bound);
+  SAME(tracking_friction_after_restart);
   SAME(force_limit_kN); SAME(release_min_speed_rev_per_s); SAME(deadline_s);
   SAME(residual_stats_clip); SAME(eol_friction_model_share); SAME(eol_creep_model); SAME(eol_friction_load_model); SAME(eol_thermal_offset_model); SAME(eol_viscous_model); SAME(eol_viscous_narrows_speed_allowance); SAME(calibrated_two_friction_models); SAME(calibrated_capped_by_eol);
   SAME(hold_kN); SAME(hold_speed_rev_per_s); SAME(hold_span_rev); SAME(hold_span_known_rev); SAME(hold_settle_samples); SAME(hold_settled_within_kN);

@@ -158,7 +158,7 @@ void Calibrator::reset_curve(const Curve& curve) {
   stats_.curve_data_max_rev = 0.0;
 }
 
-void Calibrator::set_friction_stiffness(const std::vector<double>& k_kN_per_rev) {
+void Calibrator::set_friction_stiffness(const std::vector<double>& k_kN_per_rev, bool from_fits) {
   if (k_kN_per_rev.size() != friction_.delta_rev.size()) {
     throw std::invalid_argument("set_friction_stiffness: expected " + std::to_string(friction_.delta_rev.size()) +
                                 " stiffnesses, got " + std::to_string(k_kN_per_rev.size()));
@@ -167,6 +167,7 @@ void Calibrator::set_friction_stiffness(const std::vector<double>& k_kN_per_rev)
     friction_.stiffness_kN_per_rev[i] = k_kN_per_rev[i];
     phi_kN_[i] = k_kN_per_rev[i] * friction_.delta_rev[i];
   }
+  prior_friction_fitted_ = from_fits;
 }
 
 double Calibrator::poly_basis_x(double x_rev, int power) const {
@@ -527,6 +528,7 @@ Estimate Calibrator::update(const Sample& s) {
     ++stats_.samples_rejected;
     e.valid = false;
     e.calibrated = stats_.fits_accepted > 0;
+    e.friction_fitted = states_known_ && (e.calibrated || prior_friction_fitted_);
     return e;
   }
   // The load cell's thermal offset removed first: the model never sees it.
@@ -618,6 +620,7 @@ Estimate Calibrator::update(const Sample& s) {
     e.force_kN = e.curve_force_kN + sum / static_cast<double>(residual_count_);
   }
   e.calibrated = stats_.fits_accepted > 0;
+  e.friction_fitted = states_known_ && (e.calibrated || prior_friction_fitted_);
   return e;
 }
 

@@ -125,11 +125,23 @@ void CornerSupervisor::restart_calibrator() {
   calibration::CalibratorConfig cfg = config_;
   cfg.initial_curve = good.curve;
   calibrator_.emplace(cfg);
-  calibrator_->set_friction_stiffness(good.stiffness_kN_per_rev);
+  calibrator_->set_friction_stiffness(good.stiffness_kN_per_rev, good.from_fit);
   calibrator_->note_prior_curve_data(good.data.lo_rev, good.data.hi_rev);
   fusion_.reset();
   last_fed_time_s_ = std::numeric_limits<double>::quiet_NaN();
   ++restarts_;
+}
+
+double CornerSupervisor::friction_before(double time_s) const {
+  // The newest kept sample older than time_s; the oldest kept if none is (an onset further back
+  // than the history); the last one if none was kept.
+  double friction_kN = last_friction_kN_;
+  for (std::size_t i = 0; i < friction_count_; ++i) {
+    const std::size_t k = (friction_head_ + kFrictionHistory - 1 - i) % kFrictionHistory;
+    friction_kN = friction_history_kN_[k];
+    if (friction_time_s_[k] < time_s) break;
+  }
+  return friction_kN;
 }
 
 void CornerSupervisor::react_to_new_findings() {
@@ -149,8 +161,10 @@ void CornerSupervisor::react_to_new_findings() {
   }
   if (!monitor_.ok(Part::Resolver) && !resolver_reacted_) {
     resolver_reacted_ = true;
-    frozen_friction_kN_ = last_friction_kN_;
-    load_friction_kN_ = std::clamp(last_friction_kN_, -monitor_.params().eol_friction_half_width_kN,
+    const double friction_kN = monitor_.params().lost_resolver_friction_before_onset
+                                   ? friction_before(monitor_.diagnosis(Part::Resolver).onset_s)
+                                   : last_friction_kN_;
+    load_friction_kN_ = std::clamp(friction_kN, -monitor_.params().eol_friction_half_width_kN,
                                    monitor_.params().eol_friction_half_width_kN);
     load_filtered_kN_ = std::numeric_limits<double>::quiet_NaN();
   }
@@ -202,7 +216,8 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
     const double hw = monitor_.params().eol_friction_half_width_kN;
     monitored_kN += e.friction_kN - std::clamp(e.friction_kN, -hw, hw);
   }
-  monitor_.update(r, check, fed, monitored_kN, arrival_s);
+  monitor_.update(r, check, fed, monitored_kN, arrival_s,
+                  view_.source == EstimateSource::LoadCell ? load_friction_kN_ : std::numeric_limits<double>::quiet_NaN());
   if (monitor_.take_rejoin()) rejoin();
   if (monitor_.take_load_cell_cleared()) resume_after_dropout();
   if (monitor_.take_resolver_cleared()) resume_after_resolver();
@@ -218,7 +233,13 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
       monitor_.set_fit_rms(calibrator_->stats().last_fit_rms_kN);  // its model uncertainty
       monitor_.set_fit_friction_amplitude(friction_amplitude_kN(calibrator_->friction()));
     }
-    if (monitor_.ok(Part::Resolver)) last_friction_kN_ = e.friction_kN;
+    if (monitor_.ok(Part::Resolver)) {
+      last_friction_kN_ = e.friction_kN;
+      friction_time_s_[friction_head_] = r.time_s;
+      friction_history_kN_[friction_head_] = e.friction_kN;
+      friction_head_ = (friction_head_ + 1) % kFrictionHistory;
+      friction_count_ = std::min(friction_count_ + 1, kFrictionHistory);
+    }
   }
   refresh_view(check.usable() ? &r : nullptr, &check, fed);
   last_estimate_ = fed != nullptr ? e : calibration::Estimate{};

@@ -270,7 +270,7 @@ void FaultMonitor::set_curve_range(double min_rev, double max_rev) {
 }
 
 void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, const calibration::Estimate* estimate,
-                          double force_estimate_kN, double arrival_s) {
+                          double force_estimate_kN, double arrival_s, double load_cell_friction_kN) {
   // Any arrival, even a corrupt one, shows that the corner is there; the end of an outage that
   // lost samples breaks every detector's continuity. A delay loses none: when the first sample
   // after the outage continues the corner's sequence, every detector keeps its state (resetting
@@ -359,9 +359,13 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   if (commutation_lost()) {
     tracking_.on_rejoin();
   } else {
-    const bool friction_known = estimate != nullptr && estimate->valid && estimate->calibrated && check.load_cell_present &&
-                                arbiter_.ok(Part::LoadCell);
-    tracking_.update(c, force_estimate_kN, friction_known ? estimate->friction_kN : 0.0, clamp_upper_kN, clamp_lower_kN, p_, arbiter_);
+    const bool fitted = estimate != nullptr && (p_.tracking_friction_after_restart ? estimate->friction_fitted : estimate->calibrated);
+    const bool lc_trusted = check.load_cell_present && arbiter_.ok(Part::LoadCell);
+    double friction_kN = fitted && estimate->valid && lc_trusted ? estimate->friction_kN : 0.0;
+    if (estimate == nullptr && lc_trusted && p_.lost_resolver_tracking_counts_friction && std::isfinite(load_cell_friction_kN)) {
+      friction_kN = load_cell_friction_kN;
+    }
+    tracking_.update(c, force_estimate_kN, friction_kN, clamp_upper_kN, clamp_lower_kN, p_, arbiter_);
   }
 
   prev_ = r;

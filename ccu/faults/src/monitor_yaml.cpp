@@ -166,6 +166,11 @@ MonitorParams read_monitor_params(Reader& r) {
   p.calibrator_initial_curve_from_eol = start.boolean("initial_curve_from_end_of_line");
   start.finish();
 
+  auto lost_resolver = r.map("resolver_lost");
+  p.lost_resolver_friction_before_onset = lost_resolver.boolean("friction_from_before_onset");
+  p.lost_resolver_tracking_counts_friction = lost_resolver.boolean("tracking_counts_friction");
+  lost_resolver.finish();
+
   auto t = r.map("torque");
   p.torque_filter_s = t.number("filter_s", pos);
   p.torque_check_min_load_kN = t.number("check_min_load_kN", pos);
@@ -216,6 +221,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.tracking_full_speed_fraction = k.number("full_speed_fraction", config::Range::closed(0.0, 1.0));
   p.tracking_excess_position_bound = k.boolean("excess_position_bound");
   p.tracking_shortfall_position_bound = k.boolean("shortfall_position_bound");
+  p.tracking_friction_after_restart = k.boolean("friction_after_restart");
   p.force_limit_kN = k.number("force_limit_kN", pos);
   p.release_min_speed_rev_per_s = k.number("release_min_speed_rev_per_s", pos);
   k.finish();

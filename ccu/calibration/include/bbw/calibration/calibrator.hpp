@@ -33,6 +33,11 @@ struct Estimate {
   double curve_force_kN = 0.0;  // A x^3 + B x^2 + C x + D at the sample's position
   bool valid = false;           // false when the sample was rejected (NaN, out of range, time backwards)
   bool calibrated = false;      // true once at least one cycle fit was accepted
+  // The friction term is a fitted one where the keys are: its K_i come from accepted fits (this
+  // calibrator's, or those of the snapshot a restarted one was given, set_friction_stiffness(k,
+  // true)) and every element's state is known (the position has swept 2 Delta_max since the
+  // start). A restarted calibrator has it before its first fit of its own (calibrated).
+  bool friction_fitted = false;
   bool cycle_start = false;     // a new hysteresis cycle started at this sample
   bool fit_accepted = false;    // a cycle-end fit was accepted at this sample
 };
@@ -78,7 +83,8 @@ class Calibrator {
   // Restart from a known curve (e.g. a restarted corner's last good curve). Keeps stats and K_i.
   void reset_curve(const Curve& curve);
   // Friction stiffnesses from elsewhere (e.g. the last good state); sizes must match M.
-  void set_friction_stiffness(const std::vector<double>& k_kN_per_rev);
+  // from_fits: they were fitted (Estimate::friction_fitted once the states are known).
+  void set_friction_stiffness(const std::vector<double>& k_kN_per_rev, bool from_fits = false);
   // Where the current curve already had data before this calibrator (a restart from a snapshot):
   // joined into Stats::curve_data_* as an accepted fit's span is. Ignored when empty (lo > hi).
   void note_prior_curve_data(double lo_rev, double hi_rev) { note_curve_data(lo_rev, hi_rev); }
@@ -131,6 +137,7 @@ class Calibrator {
   // cycle starts before that are ignored.
   StatesKnown states_known_rule_;
   bool states_known_ = false;
+  bool prior_friction_fitted_ = false;  // set_friction_stiffness(k, true)
   std::vector<char> identified_;  // per phi: identified by at least one accepted fit
 
   std::vector<double> element_pos_rev_;  // live element positions x_i

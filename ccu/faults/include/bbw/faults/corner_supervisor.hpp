@@ -9,6 +9,8 @@
 //   command to the corner: v.available, v.force_limit_kN (Redistributor), v.feedback, v.curve
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -103,7 +105,14 @@ class CornerSupervisor {
   bool resolver_reacted_ = false;
   calibration::Curve trusted_curve_;
   double last_friction_kN_ = 0.0;
-  double frozen_friction_kN_ = 0.0;
+  // The calibrator's friction over the last kFrictionHistory samples fed while the resolver was
+  // judged right (time, friction; a ring): the friction a resolver finding freezes is the one
+  // from before its onset (MonitorParams::lost_resolver_friction_before_onset).
+  static constexpr std::size_t kFrictionHistory = 256;
+  std::array<double, kFrictionHistory> friction_time_s_{};
+  std::array<double, kFrictionHistory> friction_history_kN_{};
+  std::size_t friction_head_ = 0, friction_count_ = 0;
+  double friction_before(double time_s) const;
   // After a resolver fault: the key friction followed from the load cell's own motion (a play in
   // force: it absorbs a change of the load up to its width, then the clamp force moves).
   double load_friction_kN_ = 0.0;

@@ -395,6 +395,17 @@ struct MonitorParams {
   // configured initial curve (the shipped caliper's end-of-line cubic). Its fits replace the
   // initial curve only where their cycles had data (calibrator_start in corner_supervisor.hpp).
   bool calibrator_initial_curve_from_eol = true;
+  // After a resolver finding the estimate is the load cell less the friction frozen at the
+  // finding: the friction as it was before the fault's onset (the newest of the last
+  // CornerSupervisor::kFrictionHistory samples older than it), not at the confirming sample. A
+  // resolver offset's jump swings the calibrator's friction states before it is confirmed: frozen
+  // there, -4.9 kN instead of +3.8 put the estimate 6.4 kN above the clamp force and named the
+  // healthy actuator actuator_not_releasing (faster-driver campaign seed 3102 run 55).
+  bool lost_resolver_friction_before_onset = true;
+  // And the tracking rules count that friction as they count the calibrator's (the estimate is
+  // the load cell less it): without, a caliper whose keys held its clamp force 2.7 kN below a
+  // 10 kN command in a hold was named actuator_tracking once its resolver was named (run 55).
+  bool lost_resolver_tracking_counts_friction = true;
 
   // Actuator torque balance: the torque the axial load and the acceleration need,
   // load * Nm_per_kN + J 2 pi a, against the torque the measured current should make,
@@ -568,6 +579,14 @@ struct MonitorParams {
   // cell reading less is the keys' friction pulling it (a caliper whose 3.9 kN keys read -3.9 kN
   // at rest after a hard stop's release against a zero command, extreme hunt seed 2614 run 262).
   bool tracking_shortfall_position_bound = true;
+  // The calibrator's friction counts (see TrackingDetector) once its friction term is fitted
+  // where the keys are (calibration::Estimate::friction_fitted): after a restart (a corner back
+  // from a lost link or a cleared sensor finding) that is as soon as the snapshot's K_i it
+  // restarted with have their states again, not only after its first fit of its own. Off: only
+  // after that fit; until then the keys' friction, 3-4 kN on the extreme population, counted
+  // as a brake holding force (faster-driver campaign seed 3102 runs 27, 61, 101, 377: a healthy
+  // corner named actuator_not_releasing in a slow release after the corner came back).
+  bool tracking_friction_after_restart = true;
 
   // Link: no sample for this long is a lost link (the DDS deadline in the process).
   double deadline_s = 0.015;
@@ -585,8 +604,11 @@ class FaultMonitor {
   // One sample. `check` is the guard's verdict on it; `estimate` is the calibrator's output for
   // it when the calibrator was fed (nullptr otherwise); `force_estimate_kN` is the clamp force
   // the CCU currently believes (NaN when it has none); arrival_s is when the CCU got it.
+  // `load_cell_friction_kN`: when force_estimate_kN is the load cell less a friction that is not
+  // the calibrator's (after a resolver finding, the frozen one), that friction; NaN otherwise.
   void update(const CornerReading& r, const SampleCheck& check, const calibration::Estimate* estimate,
-              double force_estimate_kN, double arrival_s);
+              double force_estimate_kN, double arrival_s,
+              double load_cell_friction_kN = std::numeric_limits<double>::quiet_NaN());
   void on_link_event(LinkEvent e, double time_s) { link_.on_link_event(e, time_s, arbiter_); }
   // Deadline check at the CCU's time now_s.
   void tick(double now_s) { link_.tick(now_s, p_, arbiter_); }
