@@ -1087,6 +1087,35 @@ TEST(ClosedLoopIssue14, AResolverFindingFreezesTheFrictionFromBeforeItsOnset) {
               with_kN, at_finding_kN, to_string(actuator(neither, rl).finding), to_string(actuator(uncounted, rl).finding));
 }
 
+// A caliper with the plant's viscous friction, driven 2.5 times faster (faster-driver campaign
+// run 267): its applies at up to 25 rev/s add 2-5 kN of viscous force to the load cell, which the
+// calibrator's fits took for key friction (8.7 kN on keys that hold 3.2): in the 34.5 kN hard stop
+// the estimate was 5.5 kN low, before and after its drive seized. The end-of-line test measured
+// the viscous friction, and the corner's calibrator now fits its own viscous term
+// (calibrator_start.viscous_term_from_end_of_line). The seizure is still named in its window.
+TEST(ClosedLoopIssue14, AViscousCalipersCalibratorFitsItsOwnViscousTerm) {
+  const auto fs = load("config/scenarios/faults/viscous_caliper_seized_in_a_hard_stop_of_a_fast_driver.yaml");
+  const std::size_t fl = 0;
+  // From its first fit (6.3 s) to the seized drive's release: holds, fast applies and releases,
+  // the hard stop and the seizure in it. (Before the first fit the estimate is the load cell, the
+  // same either way.)
+  const double from_s = 6.5, to_s = 15.7;
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << to_string(r.outcomes[0].diagnosis);
+  EXPECT_EQ(r.faults_raised(), 1u);
+  auto opts = default_options();
+  opts.monitor.calibrator_viscous_from_eol = false;
+  const auto base = run_closed_loop(fs, opts);
+  const double with_kN = worst_estimate_error_kN(r, fl, from_s, to_s);
+  const double without_kN = worst_estimate_error_kN(base, fl, from_s, to_s);
+  const double hold_without_kN = worst_estimate_error_kN(base, fl, 14.0, to_s);
+  std::printf("FL from its first fit to the seizure's end, worst |estimate - clamp force|: %.2f kN with its own viscous "
+              "term, %.2f without (%.2f in the hard stop)\n", with_kN, without_kN, hold_without_kN);
+  EXPECT_LT(with_kN, 0.5);
+  EXPECT_GT(hold_without_kN, 4.0);
+}
+
 // A hold's reference is set only from settle samples that lie within hold.settled_within_kN of
 // each other (soft10_ff run 2): FL's 5 ms load-cell lag after its wide keys reversed made the
 // residual fall 1.3 kN across the settle samples; their mean, taken as the hold's level, named

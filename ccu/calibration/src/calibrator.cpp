@@ -604,6 +604,8 @@ Estimate Calibrator::update(const Sample& s) {
 
   e.valid = true;
   e.friction_kN = f_fric;
+  // (The viscous column is the first after the elements: effect_columns.)
+  e.viscous_kN = config_.viscous_friction ? phi_kN_[static_cast<std::size_t>(m_)] * n_now_[static_cast<std::size_t>(m_)] : 0.0;
   e.curve_force_kN = curve_.force_kN(x_now);
   e.force_kN = f_c - f_fric;
   if (delayed) e.force_kN += e.curve_force_kN - curve_.force_kN(x);

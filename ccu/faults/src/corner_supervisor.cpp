@@ -23,14 +23,12 @@ double friction_amplitude_kN(const calibration::FrictionParams& f) {
   return sum;
 }
 
-// The monitor's parameters beside this calibrator: its curve's range, and no viscous model of its
-// own when the calibrator fits one.
+// The monitor's parameters beside this calibrator: its curve's range. (A calibrator that fits its
+// own viscous term has it in its friction; the residual rules take it out, calibration::Estimate::
+// viscous_kN, and keep the end-of-line viscous model, MonitorParams::eol_viscous_model.)
 MonitorParams for_calibrator(MonitorParams p, const calibration::CalibratorConfig& c) {
   p.curve_min_rev = c.x_min_rev;
   p.curve_max_rev = c.x_max_rev;
-  // A calibrator that fits its own viscous term has it in its friction: the monitor's end-of-line
-  // viscous model would count it twice (MonitorParams::eol_viscous_model).
-  if (c.viscous_friction) p.eol_viscous_kN_per_rev_per_s = 0.0;
   return p;
 }
 
@@ -52,6 +50,8 @@ calibration::CalibratorConfig accepting(calibration::CalibratorConfig c, const M
 // where their cycles had data: elsewhere a caliper 0.4 x as stiff kept the shipped caliper's
 // forces, 5-8 kN where it clamped 1 (faster-driver campaign run 68).
 calibration::CalibratorConfig calibrator_start(calibration::CalibratorConfig c, const MonitorParams& m) {
+  // A drive whose viscous friction the end-of-line test measured: the calibrator fits its own.
+  if (m.calibrator_viscous_from_eol && m.eol_curve && m.eol_viscous_kN_per_rev_per_s > 0.0) c.viscous_friction = true;
   // (An empty range is the calibrator's to refuse, with its own message.)
   if (!m.calibrator_initial_curve_from_eol || !m.eol_curve || !(c.x_max_rev > c.x_min_rev)) return c;
   const plant::ClampCurve eol(*m.eol_curve);
@@ -213,8 +213,10 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
   refresh_view(check.usable() ? &r : nullptr, &check, fed);
   double monitored_kN = view_.force_estimate_kN;
   if (fed != nullptr && e.valid && view_.source == EstimateSource::Calibrator && monitor_.params().eol_curve) {
+    // (The key friction: the calibrator's viscous term is not bounded by the keys.)
     const double hw = monitor_.params().eol_friction_half_width_kN;
-    monitored_kN += e.friction_kN - std::clamp(e.friction_kN, -hw, hw);
+    const double keys_kN = e.friction_kN - e.viscous_kN;
+    monitored_kN += keys_kN - std::clamp(keys_kN, -hw, hw);
   }
   monitor_.update(r, check, fed, monitored_kN, arrival_s,
                   view_.source == EstimateSource::LoadCell ? load_friction_kN_ : std::numeric_limits<double>::quiet_NaN());
@@ -234,9 +236,10 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
       monitor_.set_fit_friction_amplitude(friction_amplitude_kN(calibrator_->friction()));
     }
     if (monitor_.ok(Part::Resolver)) {
-      last_friction_kN_ = e.friction_kN;
+      // The keys' friction (a viscous term's part moves with the speed: not frozen).
+      last_friction_kN_ = e.friction_kN - e.viscous_kN;
       friction_time_s_[friction_head_] = r.time_s;
-      friction_history_kN_[friction_head_] = e.friction_kN;
+      friction_history_kN_[friction_head_] = last_friction_kN_;
       friction_head_ = (friction_head_ + 1) % kFrictionHistory;
       friction_count_ = std::min(friction_count_ + 1, kFrictionHistory);
     }

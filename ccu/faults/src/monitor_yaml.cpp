@@ -164,6 +164,7 @@ MonitorParams read_monitor_params(Reader& r) {
 
   auto start = r.map("calibrator_start");
   p.calibrator_initial_curve_from_eol = start.boolean("initial_curve_from_end_of_line");
+  p.calibrator_viscous_from_eol = start.boolean("viscous_term_from_end_of_line");
   start.finish();
 
   auto lost_resolver = r.map("resolver_lost");

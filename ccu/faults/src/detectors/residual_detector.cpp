@@ -370,15 +370,17 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     eol_mode_ = false;
   } else {
     if (eol_) {
-      // The calibrator's friction, within what the caliper's key friction can hold (a fit that
-      // explains more than the end-of-line width as friction is wrong, not the load cell).
+      // The calibrator's key friction, within what the caliper's keys can hold (a fit that
+      // explains more than the end-of-line width as friction is wrong, not the load cell). Its
+      // viscous term (when it fits one) is not the keys': the end-of-line model has the drive's
+      // (lc_extra_kN), and counting both took it out twice.
       const double hw = scaled_half_width_kN(p);
-      const double friction_kN = std::clamp(e.friction_kN, -hw, hw);
+      const double friction_kN = std::clamp(e.friction_kN - e.viscous_kN, -hw, hw);
       // At the motor's position, as the calibrator fitted its friction (the spindle's, with a
       // backlash corner's play, mixed the two and raised 6 fault-free findings on backlash corners).
       const double eol_motor_kN =
           x_keys_rev == r.position_rev ? eol_keys_kN : pads_kN(r.position_rev);
-      const double load_cell_kN = e.force_kN + e.friction_kN;  // the calibrator's filtered load cell
+      const double load_cell_kN = e.force_kN + e.friction_kN;  // the calibrator's filtered load cell (with c_v v)
       residual_kN_ = load_cell_kN - friction_kN - eol_motor_kN;
       if (friction_known_ && p.calibrated_two_friction_models) {
         // Two models of the key friction: the calibrator's (fitted to the cycles, on the

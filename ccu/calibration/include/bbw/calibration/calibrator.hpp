@@ -30,6 +30,7 @@ struct Sample {
 struct Estimate {
   double force_kN = 0.0;        // f_hat = load cell minus estimated friction
   double friction_kN = 0.0;     // estimated key/keyway friction sum K_i Delta_i n_i (+ c_v v when enabled)
+  double viscous_kN = 0.0;      // the c_v v part of friction_kN (0 without the viscous term)
   double curve_force_kN = 0.0;  // A x^3 + B x^2 + C x + D at the sample's position
   bool valid = false;           // false when the sample was rejected (NaN, out of range, time backwards)
   bool calibrated = false;      // true once at least one cycle fit was accepted

@@ -123,8 +123,8 @@ struct MonitorParams {
   // eol_thermal_offset_model the residual rules expect it in the load cell's reading.
   bool eol_thermal_offset_model = true;
   // The drive's viscous friction (the plant's c_v v, on the spindle's speed), as the end-of-line
-  // test measured it (CcuCore sets the corner's; 0: none, and 0 when the calibrator fits its own
-  // viscous term): with eol_viscous_model the residual rules expect it in the load cell's reading
+  // test measured it (CcuCore sets the corner's; 0: none; a calibrator's own viscous term is taken
+  // out of its friction where they meet): with eol_viscous_model the residual rules expect it in the load cell's reading
   // while the spindle moves (the motor's measured speed, 0 while the motor crosses the play).
   // Without, a calibrated viscous caliper reversing from a -2 rev/s release into a +2.7 rev/s
   // apply moved its residual by 0.55 kN against the change rule's 0.48 kN (extreme hunt seed 2613
@@ -395,6 +395,12 @@ struct MonitorParams {
   // configured initial curve (the shipped caliper's end-of-line cubic). Its fits replace the
   // initial curve only where their cycles had data (calibrator_start in corner_supervisor.hpp).
   bool calibrator_initial_curve_from_eol = true;
+  // With an end-of-line test that measured the drive's viscous friction (eol_viscous_kN_per_rev_
+  // per_s > 0), the corner's calibrator fits its own viscous term (c_v v, CalibratorConfig::
+  // viscous_friction). Without it, the fits took the viscous force of fast applies and releases
+  // for key friction: 7.3-8.7 kN of friction on keys that hold 3.2-3.7 kN, the estimate 3.5-5.5 kN
+  // off in holds (faster-driver campaign seed 3102 runs 27 and 267).
+  bool calibrator_viscous_from_eol = true;
   // After a resolver finding the estimate is the load cell less the friction frozen at the
   // finding: the friction as it was before the fault's onset (the newest of the last
   // CornerSupervisor::kFrictionHistory samples older than it), not at the confirming sample. A
