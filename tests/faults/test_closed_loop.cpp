@@ -1116,6 +1116,37 @@ TEST(ClosedLoopIssue14, AViscousCalipersCalibratorFitsItsOwnViscousTerm) {
   EXPECT_GT(hold_without_kN, 4.0);
 }
 
+// Calipers three to ten times stiffer with backlash, their force loops hunting in the play: the
+// motor goes 0.06 rev down and back up while the clamp force stands (stiff10 run 339, fault-free).
+// Before the play's state is known, the hold's allowance for it counted the curve's net change
+// (0.2 kN) and not the 1.1 kN of the motor's crossing: load_cell_offset on RR and RL. Counted over
+// the span of the motor's positions (residual.hold.play_allowance_over_span), nothing is raised.
+TEST(ClosedLoopIssue14, AForceLoopHuntingAcrossThePlayIsNotALoadCellOffset) {
+  expect_quiet_only_with_the_rule("config/scenarios/faults/fault_free_stiff_calipers_hunting_in_their_play.yaml",
+                                  "the hold's play allowance over the motor's span", Finding::LoadCellOffset,
+                                  [](MonitorParams& m) { m.hold_play_allowance_over_span = false; });
+}
+
+// Beside a resolver offset on FL, RR (ten times stiffer, backlash, keys 3.4 kN wide) moved its motor
+// 0.053 rev back across the play in a hold, the clamp force standing (stiff10 run 13). Before the
+// play's state is known the end-of-line residual reads the curve at the motor's position: it moved
+// 1.4 kN past the band, and RR was named load_cell_offset. With the band's play allowance
+// (residual.end_of_line.play_allowance) only FL's offset is named, in its window.
+TEST(ClosedLoopIssue14, TheEndOfLineBandAllowsForThePlayWhileItsStateIsUnknown) {
+  const auto fs = load("config/scenarios/faults/resolver_offset_beside_a_stiff_caliper_crossing_its_play.yaml");
+  const std::size_t rr = 3;
+  const auto r = run_closed_loop(fs, default_options());
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  EXPECT_TRUE(r.outcomes[0].detected && r.outcomes[0].correct) << to_string(r.outcomes[0].diagnosis);
+  EXPECT_EQ(r.faults_raised(), 1u);
+  auto opts = default_options();
+  opts.monitor.eol_play_allowance = false;
+  const auto base = run_closed_loop(fs, opts);
+  EXPECT_EQ(load_cell(base, rr).finding, Finding::LoadCellOffset) << to_string(load_cell(base, rr).finding);
+  std::printf("RR beside FL's resolver offset: %zu findings with the play allowance, %zu without (RR %s at %.3f s)\n",
+              r.faults_raised(), base.faults_raised(), to_string(load_cell(base, rr).finding), load_cell(base, rr).detected_s);
+}
+
 // A hold's reference is set only from settle samples that lie within hold.settled_within_kN of
 // each other (soft10_ff run 2): FL's 5 ms load-cell lag after its wide keys reversed made the
 // residual fall 1.3 kN across the settle samples; their mean, taken as the hold's level, named

@@ -49,6 +49,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.eol_viscous_narrows_speed_allowance = eol.boolean("viscous_narrows_speed_allowance");
     p.calibrated_two_friction_models = eol.boolean("calibrated_two_friction_models");
     p.calibrated_capped_by_eol = eol.boolean("calibrated_capped");
+    p.eol_play_allowance = eol.boolean("play_allowance");
     eol.finish();
   }
   {
@@ -65,6 +66,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.hold_friction_swing = h.boolean("friction_swing");
     p.hold_restart_untrusted = h.boolean("restart_untrusted");
     p.hold_play_allowance = h.boolean("play_allowance");
+    p.hold_play_allowance_over_span = h.boolean("play_allowance_over_span");
     h.finish();
   }
   {

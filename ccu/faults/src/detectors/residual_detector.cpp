@@ -362,6 +362,13 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
     }
     thr = eol_allowance_kN(p, p.eol_band_kN, friction_band_kN, eol_kN, r.speed_rev_per_s);
     thr0 = eol_allowance_kN(p, p.eol_band_kN, friction_band_kN, eol_kN, 0.0);
+    if (p.eol_play_allowance && p.eol_backlash_rev > 0.0 && !friction_known_) {
+      // The curve is read at the motor's position; the spindle may be up to half the play away.
+      const double b = 0.5 * p.eol_backlash_rev;
+      const double play_kN = std::max(clamp_kN(x_keys_rev + b) - clamp_kN(x_keys_rev), clamp_kN(x_keys_rev) - clamp_kN(x_keys_rev - b));
+      thr += play_kN;
+      thr0 += play_kN;
+    }
     if (!eol_mode_) have_reference_ = false;
     eol_mode_ = true;
   } else if (!e.calibrated) {
@@ -561,7 +568,9 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
       // The hold's position is the motor's: inside the play the spindle may have stood.
       const double b = 0.5 * p.eol_backlash_rev;
       const double across_play_kN = clamp_kN(x_hold + b) - clamp_kN(x_hold - b);
-      hold_thr += std::min(std::abs(hold_curve_kN - hold_f0_kN_), across_play_kN);
+      const double moved_kN = p.hold_play_allowance_over_span ? clamp_kN(hold_x_max_rev_) - clamp_kN(hold_x_min_rev_)
+                                                              : std::abs(hold_curve_kN - hold_f0_kN_);
+      hold_thr += std::min(moved_kN, across_play_kN);
     }
     hold_threshold_kN_ = hold_thr;
     hold_over = std::abs(hold_change_kN_) > hold_thr;

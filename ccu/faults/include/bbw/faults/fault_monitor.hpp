@@ -104,6 +104,12 @@ struct MonitorParams {
   // statistics could follow a slow drift while the brake modulates (tune_bias run 145: a
   // 1.2 kN/s drift in ABS braking, threshold 1.9 -> 8.7 kN in 3.4 s, never named).
   bool calibrated_capped_by_eol = true;
+  // On a caliper with backlash, before the play's state is known (the end-of-line curve is read at
+  // the motor's position): the end-of-line band adds what the curve can change between the
+  // motor's position and the furthest the spindle can be from it (half the play). Without, a loop
+  // that moved the motor 0.053 rev back across the play of a caliper ten times stiffer, the clamp
+  // force standing, moved the residual by 1.4 kN past the band (stiff10 run 13: load_cell_offset).
+  bool eol_play_allowance = true;
   // The caliper's backlash between the motor (the resolver) and the spindle (the keys, the
   // pads), as its end-of-line test measured it (CcuCore sets the corner's; 0: none).
   double eol_backlash_rev = 0.0;
@@ -185,6 +191,12 @@ struct MonitorParams {
   // 0.015 rev inside the play at a constant clamp force moved the residual by -0.77 kN on a caliper
   // ten times stiffer (stiff10_ff runs 1, 129, 189).
   bool hold_play_allowance = true;
+  // ... the curve's span over the positions the motor took in the hold (its lowest to its
+  // highest), not its net change: a motor that went down and back up inside the play has crossed
+  // it, the spindle standing. Without, a loop hunting 0.05 rev in the play of a caliper ten times
+  // stiffer moved the residual by 1.1 kN at a net 0.2 kN change of the curve (stiff10 run 339,
+  // fault-free: load_cell_offset on RR and RL).
+  bool hold_play_allowance_over_span = true;
   // Usable samples more than jump_max_gap_s apart (those between rejected by the guard, e.g. a
   // position beyond its range): the positions between went unseen, so the end-of-line friction
   // model's state (the play's, the sweep's) is forgotten and the rules' references restart, as
