@@ -76,6 +76,9 @@ faults::MonitorParams corner_monitor_params(const scenario::Scenario& scenario, 
   // And its drive's viscous friction (0: none).
   const auto& viscous = corner.effects.viscous_friction;
   corner_mp.eol_viscous_kN_per_rev_per_s = viscous.enabled ? viscous.coefficient_kN_per_rev_per_s : 0.0;
+  // And its load cell's lag behind the resolver (0: none).
+  const auto& delay = corner.effects.sensor_delay;
+  corner_mp.eol_load_cell_delay_s = delay.enabled ? delay.delay_s : 0.0;
   return corner_mp;
 }
 

@@ -1147,6 +1147,21 @@ TEST(ClosedLoopIssue14, TheEndOfLineBandAllowsForThePlayWhileItsStateIsUnknown) 
               r.faults_raised(), base.faults_raised(), to_string(load_cell(base, rr).finding), load_cell(base, rr).detected_s);
 }
 
+// Load cells lagging their resolvers by 5 ms (the plant's sensor delay) in ABS-like modulation, on a
+// caliper up to ten times softer with 4 kN keys (soft10 run 29) and on one up to ten times stiffer
+// (stiff10_ff run 3), fault-free. At each reversal the end-of-line friction model flipped 5 ms
+// before the load cell: steps of the residual named FL's load cell noisy, and RR's offset. With the
+// model on the position the reading belongs to, as the end-of-line test measured the lag
+// (residual.end_of_line.delay_model), nothing is raised.
+TEST(ClosedLoopIssue14, TheEndOfLineModelFollowsALaggingLoadCell) {
+  expect_quiet_only_with_the_rule("config/scenarios/faults/fault_free_soft_caliper_lagging_load_cell_in_abs.yaml",
+                                  "the end-of-line model on the lagged position", Finding::LoadCellNoisy,
+                                  [](MonitorParams& m) { m.eol_delay_model = false; });
+  expect_quiet_only_with_the_rule("config/scenarios/faults/fault_free_stiff_caliper_lagging_load_cell_in_abs.yaml",
+                                  "the end-of-line model on the lagged position", Finding::LoadCellOffset,
+                                  [](MonitorParams& m) { m.eol_delay_model = false; });
+}
+
 // A hold's reference is set only from settle samples that lie within hold.settled_within_kN of
 // each other (soft10_ff run 2): FL's 5 ms load-cell lag after its wide keys reversed made the
 // residual fall 1.3 kN across the settle samples; their mean, taken as the hold's level, named

@@ -65,7 +65,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(tracking_time_constant_s); SAME(tracking_threshold_kN); SAME(tracking_relative); SAME(tracking_persist_s); SAME(tracking_excess_position_bound); SAME(tracking_shortfall_position_bound);
   SAME(tracking_friction_after_restart);
   SAME(force_limit_kN); SAME(release_min_speed_rev_per_s); SAME(deadline_s);
-  SAME(residual_stats_clip); SAME(eol_friction_model_share); SAME(eol_creep_model); SAME(eol_friction_load_model); SAME(eol_thermal_offset_model); SAME(eol_viscous_model); SAME(eol_viscous_narrows_speed_allowance); SAME(calibrated_two_friction_models); SAME(calibrated_capped_by_eol); SAME(eol_play_allowance);
+  SAME(residual_stats_clip); SAME(eol_friction_model_share); SAME(eol_creep_model); SAME(eol_friction_load_model); SAME(eol_thermal_offset_model); SAME(eol_viscous_model); SAME(eol_viscous_narrows_speed_allowance); SAME(eol_delay_model); SAME(eol_load_cell_delay_s); SAME(calibrated_two_friction_models); SAME(calibrated_capped_by_eol); SAME(eol_play_allowance);
   SAME(hold_kN); SAME(hold_speed_rev_per_s); SAME(hold_span_rev); SAME(hold_span_known_rev); SAME(hold_settle_samples); SAME(hold_settled_within_kN);
   SAME(hold_calibrated); SAME(hold_rebase); SAME(hold_friction_as_moved); SAME(hold_friction_swing); SAME(noise_paths_restart_learning); SAME(hold_restart_untrusted); SAME(hold_play_allowance); SAME(hold_play_allowance_over_span); SAME(residual_unseen_gap_forgets);
   SAME(revisit); SAME(revisit_kN); SAME(revisit_bin_rev); SAME(revisit_settle_samples); SAME(revisit_forget_s); SAME(modulation); SAME(modulation_time_constant_s); SAME(modulation_min_spread_rev_per_s);

@@ -60,6 +60,8 @@ void MonitorParams::validate() const {
           eol_friction_load_gain, "must be >= 0");
   positive("eol_friction_reference_kN", eol_friction_reference_kN);
   require(std::isfinite(eol_load_cell_kN_per_C), "eol_load_cell_kN_per_C", eol_load_cell_kN_per_C, "must be finite");
+  require(std::isfinite(eol_load_cell_delay_s) && eol_load_cell_delay_s >= 0.0 && eol_load_cell_delay_s <= 0.05,
+          "eol_load_cell_delay_s", eol_load_cell_delay_s, "must be in [0, 0.05] s");
   require(std::isfinite(eol_viscous_kN_per_rev_per_s) && eol_viscous_kN_per_rev_per_s >= 0.0, "eol_viscous_kN_per_rev_per_s",
           eol_viscous_kN_per_rev_per_s, "must be >= 0");
   require(std::isfinite(eol_load_cell_reference_C), "eol_load_cell_reference_C", eol_load_cell_reference_C, "must be finite");

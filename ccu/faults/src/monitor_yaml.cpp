@@ -47,6 +47,7 @@ MonitorParams read_monitor_params(Reader& r) {
     p.eol_thermal_offset_model = eol.boolean("thermal_offset_model");
     p.eol_viscous_model = eol.boolean("viscous_model");
     p.eol_viscous_narrows_speed_allowance = eol.boolean("viscous_narrows_speed_allowance");
+    p.eol_delay_model = eol.boolean("delay_model");
     p.calibrated_two_friction_models = eol.boolean("calibrated_two_friction_models");
     p.calibrated_capped_by_eol = eol.boolean("calibrated_capped");
     p.eol_play_allowance = eol.boolean("play_allowance");

@@ -32,6 +32,10 @@ ResidualDetector::ResidualDetector(const MonitorParams& p)
     revisit_bins_.resize(kRevisitClasses * static_cast<std::size_t>(revisit_per_class_));
   }
   if (p.eol_curve) eol_.emplace(*p.eol_curve);
+  if (p.eol_curve && p.eol_delay_model && p.eol_load_cell_delay_s > 0.0) {
+    lag_s_ = p.eol_load_cell_delay_s;
+    lagged_ = model::DelayLine(calibration::CalibratorConfig::force_delay_slots(lag_s_));
+  }
   if (p.eol_curve && p.eol_key_friction) {
     plant::KeyFrictionParams k = *p.eol_key_friction;
     k.initial_deflection = 0.0;  // the state at the start is unknown: found by sweeping
@@ -74,9 +78,16 @@ void ResidualDetector::step_creep(double x_rev, const CornerReading& r, const Mo
 }
 
 void ResidualDetector::track_position(const CornerReading& r, const MonitorParams& p) {
+  // The position the load cell's reading belongs to: lag_s_ earlier (the oldest kept at first).
+  double x_rev = r.position_rev;
+  if (lag_s_ > 0.0) {
+    lagged_.push(r.time_s, r.position_rev);
+    x_rev = lagged_.read(r.time_s - lag_s_);
+  }
+  x_lc_rev_ = x_rev;
   if (!eol_friction_) {
     spindle_moved_ = true;  // no play modelled: the spindle is the motor
-    step_creep(r.position_rev, r, p);
+    step_creep(x_rev, r, p);
     return;
   }
   // Every element's state is known once the position has risen (or fallen) by twice its
@@ -85,20 +96,20 @@ void ResidualDetector::track_position(const CornerReading& r, const MonitorParam
   // drags along within half the play (the play's state is known after the same sweep).
   if (!have_x_) {
     have_x_ = true;
-    spindle_rev_ = r.position_rev;
-    eol_friction_->reset(r.position_rev);
-    x_min_rev_ = x_max_rev_ = r.position_rev;
+    spindle_rev_ = x_rev;
+    eol_friction_->reset(x_rev);
+    x_min_rev_ = x_max_rev_ = x_rev;
   }
   const double spindle_before_rev = spindle_rev_;
-  if (p.eol_backlash_rev > 0.0) model::play_step(spindle_rev_, r.position_rev, p.eol_backlash_rev);
-  else spindle_rev_ = r.position_rev;
+  if (p.eol_backlash_rev > 0.0) model::play_step(spindle_rev_, x_rev, p.eol_backlash_rev);
+  else spindle_rev_ = x_rev;
   // The spindle moves with the motor at the play's edge; within the play it stands.
   spindle_moved_ = p.eol_backlash_rev <= 0.0 || spindle_rev_ != spindle_before_rev;
   eol_friction_kN_ = eol_friction_->step(spindle_rev_);
-  x_min_rev_ = std::min(x_min_rev_, r.position_rev);
-  x_max_rev_ = std::max(x_max_rev_, r.position_rev);
+  x_min_rev_ = std::min(x_min_rev_, x_rev);
+  x_max_rev_ = std::max(x_max_rev_, x_rev);
   const double sweep_rev = sweep_rev_ + p.eol_backlash_rev;
-  if (r.position_rev - x_min_rev_ >= sweep_rev || x_max_rev_ - r.position_rev >= sweep_rev) friction_known_ = true;
+  if (x_rev - x_min_rev_ >= sweep_rev || x_max_rev_ - x_rev >= sweep_rev) friction_known_ = true;
   step_creep(spindle_rev_, r, p);
 }
 
@@ -227,7 +238,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // the noise input, the end-of-line residual and the hold rule.
   const double temperature_C =
       eol_ && std::isfinite(r.temperature_C) ? r.temperature_C : eol_ ? eol_->params().reference_temperature_C : 0.0;
-  const double x_keys_rev = friction_known_ ? spindle_rev_ : r.position_rev;
+  // (With a load-cell lag, the position the reading belongs to: track_position's.)
+  const double x_keys_rev = friction_known_ ? spindle_rev_ : lag_s_ > 0.0 ? x_lc_rev_ : r.position_rev;
   // The pads' creep (their relaxation after the curve force changed, as the end-of-line test
   // measured it; 0 without) is part of the clamp force wherever the curve is; the pads push, never
   // pull (the plant's clamp force is at least 0). The load cell's offset with temperature (as the

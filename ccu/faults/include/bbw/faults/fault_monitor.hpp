@@ -141,6 +141,14 @@ struct MonitorParams {
   // and eol_speed_kN_per_rev_per_s, and sets the coefficient to 0 where the model is off).
   bool eol_viscous_narrows_speed_allowance = true;
   double eol_viscous_kN_per_rev_per_s = 0.0;
+  // The load cell's lag behind the resolver (the plant's sensor delay), as the end-of-line test
+  // measured it (CcuCore sets the corner's; 0: none, at most 0.05 s). With eol_delay_model the
+  // end-of-line model (its friction, the play, the curve where the keys are) follows the position
+  // that much earlier, the one the load cell's reading belongs to. Without, the model's keys
+  // flipped 5 ms before the load cell at each reversal of an ABS modulation: a soft caliper's 4 kN
+  // keys made steps of the residual that named a healthy load cell noisy (soft10 run 29).
+  bool eol_delay_model = true;
+  double eol_load_cell_delay_s = 0.0;
   double eol_load_cell_kN_per_C = 0.0;
   double eol_load_cell_reference_C = 40.0;
   double eol_friction_load_gain = 0.0;

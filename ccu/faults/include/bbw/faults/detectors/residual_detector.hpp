@@ -23,6 +23,7 @@
 #include "bbw/faults/detectors/jump_detector.hpp"
 #include "bbw/faults/detectors/noise_detector.hpp"
 #include "bbw/faults/detectors/stuck_detector.hpp"
+#include "bbw/model/delay_line.hpp"
 #include "bbw/plant/clamp_curve.hpp"
 #include "bbw/plant/key_friction.hpp"
 
@@ -47,6 +48,7 @@ class ResidualDetector {
     if (have_x_) clear_revisit();
     friction_known_ = false;
     have_x_ = false;
+    lagged_.clear();
   }
   // Call track_position() first with the same sample.
   void update(const CornerReading& r, const calibration::Estimate& e, const MonitorParams& p, DiagnosisArbiter& a,
@@ -80,6 +82,7 @@ class ResidualDetector {
     clear_revisit();  // the samples since the jump were learnt at the wrong position
     if (have_saved_) position_state() = saved_;
     else forget_position();
+    lagged_.clear();  // the positions since the jump were the wrong ones
   }
   // Whether the end-of-line friction model's state is known (the position has swept twice its
   // largest threshold since the start or the last gap), and its friction (kN).
@@ -175,6 +178,11 @@ class ResidualDetector {
   double x_min_rev_ = 0.0, x_max_rev_ = 0.0;  // since the start or the last gap
   double eol_friction_kN_ = 0.0;
   double spindle_rev_ = 0.0;  // the play operator's state (backlash)
+  // With a load-cell lag (MonitorParams::eol_delay_model): the positions, read eol_load_cell_delay_s
+  // back (lag_s_ > 0), and the position the last load-cell reading belongs to.
+  double lag_s_ = 0.0;
+  model::DelayLine lagged_{2};
+  double x_lc_rev_ = 0.0;
   bool spindle_moved_ = true;  // in the last sample (the viscous term's; MonitorParams::eol_viscous_model)
   // The position's state, one list for saving and taking it back.
   std::tuple<std::optional<plant::KeyFriction>&, bool&, bool&, double&, double&, double&, double&> position_state() {
