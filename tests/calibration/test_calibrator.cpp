@@ -187,7 +187,9 @@ TEST(Calibrator, RestartedWithFittedStiffnessesItsFrictionIsFittedOnceItsStatesA
     EXPECT_FALSE(e.calibrated);
     EXPECT_FALSE(u.friction_fitted);
     fitted_seen = fitted_seen || e.friction_fitted;
-    if (x >= 2.0 + 2.0 * c.delta_max_rev + 0.01) EXPECT_TRUE(e.friction_fitted) << "x " << x;
+    if (x >= 2.0 + 2.0 * c.delta_max_rev + 0.01) {
+      EXPECT_TRUE(e.friction_fitted) << "x " << x;
+    }
   }
   EXPECT_TRUE(fitted_seen);
 }
