@@ -4,6 +4,7 @@
 
 #include "bbw/calibration/calibrator.hpp"
 #include "bbw/model/friction_tracker.hpp"
+#include "bbw/model/delay_line.hpp"
 #include "bbw/calibration/offline.hpp"
 #include "synthetic.hpp"
 
@@ -192,6 +193,19 @@ TEST(Calibrator, RestartedWithFittedStiffnessesItsFrictionIsFittedOnceItsStatesA
     }
   }
   EXPECT_TRUE(fitted_seen);
+}
+
+// The delay line's newest value strictly before a time (what a resolver finding freezes: the
+// friction of the last sample before the fault's onset), no interpolation; the oldest kept when
+// every kept sample is newer; 0 when empty.
+TEST(DelayLine, NewestBeforeIsTheLastSampleOlderThanTheTime) {
+  bbw::model::DelayLine d(3);
+  EXPECT_EQ(d.newest_before(1.0), 0.0);
+  for (int k = 1; k <= 4; ++k) d.push(0.001 * k, 10.0 * k);  // keeps 2, 3, 4 ms: 20, 30, 40
+  EXPECT_EQ(d.newest_before(0.0035), 30.0);
+  EXPECT_EQ(d.newest_before(0.004), 30.0);  // strictly before
+  EXPECT_EQ(d.newest_before(1.0), 40.0);
+  EXPECT_EQ(d.newest_before(0.001), 20.0);  // older than all kept: the oldest
 }
 
 // Load-dependent friction term: with the same stiffnesses, the friction estimate is the plain

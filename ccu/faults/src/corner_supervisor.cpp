@@ -132,18 +132,6 @@ void CornerSupervisor::restart_calibrator() {
   ++restarts_;
 }
 
-double CornerSupervisor::friction_before(double time_s) const {
-  // The newest kept sample older than time_s; the oldest kept if none is (an onset further back
-  // than the history); the last one if none was kept.
-  double friction_kN = last_friction_kN_;
-  for (std::size_t i = 0; i < friction_count_; ++i) {
-    const std::size_t k = (friction_head_ + kFrictionHistory - 1 - i) % kFrictionHistory;
-    friction_kN = friction_history_kN_[k];
-    if (friction_time_s_[k] < time_s) break;
-  }
-  return friction_kN;
-}
-
 void CornerSupervisor::react_to_new_findings() {
   if (!monitor_.ok(Part::LoadCell) && !load_cell_reacted_) {
     // Back to the newest curve fitted before the fault began; the load cell is no longer used.
@@ -161,9 +149,10 @@ void CornerSupervisor::react_to_new_findings() {
   }
   if (!monitor_.ok(Part::Resolver) && !resolver_reacted_) {
     resolver_reacted_ = true;
+    // (Before the onset: the oldest kept if the onset is further back; none kept: 0.)
     const double friction_kN = monitor_.params().lost_resolver_friction_before_onset
-                                   ? friction_before(monitor_.diagnosis(Part::Resolver).onset_s)
-                                   : last_friction_kN_;
+                                   ? friction_history_.newest_before(monitor_.diagnosis(Part::Resolver).onset_s)
+                                   : friction_history_.read(std::numeric_limits<double>::infinity());
     load_friction_kN_ = std::clamp(friction_kN, -monitor_.params().eol_friction_half_width_kN,
                                    monitor_.params().eol_friction_half_width_kN);
     load_filtered_kN_ = std::numeric_limits<double>::quiet_NaN();
@@ -235,14 +224,8 @@ const CornerView& CornerSupervisor::on_sample(const CornerReading& r, double arr
       monitor_.set_fit_rms(calibrator_->stats().last_fit_rms_kN);  // its model uncertainty
       monitor_.set_fit_friction_amplitude(friction_amplitude_kN(calibrator_->friction()));
     }
-    if (monitor_.ok(Part::Resolver)) {
-      // The keys' friction (a viscous term's part moves with the speed: not frozen).
-      last_friction_kN_ = e.friction_kN - e.viscous_kN;
-      friction_time_s_[friction_head_] = r.time_s;
-      friction_history_kN_[friction_head_] = last_friction_kN_;
-      friction_head_ = (friction_head_ + 1) % kFrictionHistory;
-      friction_count_ = std::min(friction_count_ + 1, kFrictionHistory);
-    }
+    // The keys' friction (a viscous term's part moves with the speed: not frozen).
+    if (monitor_.ok(Part::Resolver)) friction_history_.push(r.time_s, e.friction_kN - e.viscous_kN);
   }
   refresh_view(check.usable() ? &r : nullptr, &check, fed);
   last_estimate_ = fed != nullptr ? e : calibration::Estimate{};

@@ -238,8 +238,8 @@ void ResidualDetector::update(const CornerReading& r, const calibration::Estimat
   // the noise input, the end-of-line residual and the hold rule.
   const double temperature_C =
       eol_ && std::isfinite(r.temperature_C) ? r.temperature_C : eol_ ? eol_->params().reference_temperature_C : 0.0;
-  // (With a load-cell lag, the position the reading belongs to: track_position's.)
-  const double x_keys_rev = friction_known_ ? spindle_rev_ : lag_s_ > 0.0 ? x_lc_rev_ : r.position_rev;
+  // (Before that state is known: the position the reading belongs to, track_position's.)
+  const double x_keys_rev = friction_known_ ? spindle_rev_ : x_lc_rev_;
   // The pads' creep (their relaxation after the curve force changed, as the end-of-line test
   // measured it; 0 without) is part of the clamp force wherever the curve is; the pads push, never
   // pull (the plant's clamp force is at least 0). The load cell's offset with temperature (as the

@@ -49,6 +49,19 @@ class DelayLine {
     return v_[newer];  // older than everything stored
   }
 
+  // The newest stored value strictly older than time_s, no interpolation (the last sample before
+  // an event); the oldest stored if none is older; empty: 0.
+  double newest_before(double time_s) const {
+    if (size_ == 0) return 0.0;
+    const std::size_t n = t_.size();
+    std::size_t i = head_;
+    for (std::size_t k = 0; k < size_; ++k) {
+      i = i == 0 ? n - 1 : i - 1;
+      if (t_[i] < time_s) return v_[i];
+    }
+    return v_[i];
+  }
+
   std::size_t size() const { return size_; }
   std::size_t capacity() const { return t_.size(); }
 

@@ -9,8 +9,6 @@
 //   command to the corner: v.available, v.force_limit_kN (Redistributor), v.feedback, v.curve
 #pragma once
 
-#include <array>
-#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -19,6 +17,7 @@
 #include "bbw/calibration/calibrator.hpp"
 #include "bbw/calibration/fusion.hpp"
 #include "bbw/calibration/config.hpp"
+#include "bbw/model/delay_line.hpp"
 #include "bbw/plant/clamp_curve.hpp"
 #include "bbw/corner_unit/controller.hpp"
 #include "bbw/faults/fault_monitor.hpp"
@@ -104,15 +103,11 @@ class CornerSupervisor {
   bool load_cell_reacted_ = false;
   bool resolver_reacted_ = false;
   calibration::Curve trusted_curve_;
-  double last_friction_kN_ = 0.0;
-  // The calibrator's friction over the last kFrictionHistory samples fed while the resolver was
-  // judged right (time, friction; a ring): the friction a resolver finding freezes is the one
-  // from before its onset (MonitorParams::lost_resolver_friction_before_onset).
+  // The calibrator's key friction over the last kFrictionHistory samples fed while the resolver
+  // was judged right: a resolver finding freezes the newest (or, with MonitorParams::
+  // lost_resolver_friction_before_onset, the newest before the fault's onset).
   static constexpr std::size_t kFrictionHistory = 256;
-  std::array<double, kFrictionHistory> friction_time_s_{};
-  std::array<double, kFrictionHistory> friction_history_kN_{};
-  std::size_t friction_head_ = 0, friction_count_ = 0;
-  double friction_before(double time_s) const;
+  model::DelayLine friction_history_{kFrictionHistory};
   // After a resolver fault: the key friction followed from the load cell's own motion (a play in
   // force: it absorbs a change of the load up to its width, then the clamp force moves).
   double load_friction_kN_ = 0.0;

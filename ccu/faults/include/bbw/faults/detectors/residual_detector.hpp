@@ -179,7 +179,8 @@ class ResidualDetector {
   double eol_friction_kN_ = 0.0;
   double spindle_rev_ = 0.0;  // the play operator's state (backlash)
   // With a load-cell lag (MonitorParams::eol_delay_model): the positions, read eol_load_cell_delay_s
-  // back (lag_s_ > 0), and the position the last load-cell reading belongs to.
+  // back (lag_s_ > 0). The position the last load-cell reading belongs to (track_position's: the
+  // sample's own without a lag).
   double lag_s_ = 0.0;
   model::DelayLine lagged_{2};
   double x_lc_rev_ = 0.0;
