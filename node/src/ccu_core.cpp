@@ -37,11 +37,13 @@ faults::MonitorParams monitor_params_for(const scenario::Scenario& scenario, fau
                                 std::to_string(scenario.plant_dt_s) + " s: the CCU judges test pulses of at most " +
                                 std::to_string(faults::TorqueDetector::kMaxPulseSamples) + " samples");
   }
-  // The caliper's end-of-line curve and key-friction width (measured on its production line):
-  // the residual's reference before the first fit and beyond the fitted range (issue 14).
+  // The caliper's end-of-line curve and key friction (measured on its production line): the
+  // residual's reference before the first fit and beyond the fitted range, and the calibrator's
+  // start (issue 14). The simulated line measures the plant exactly; a caller that gives its own
+  // key-friction measurement (a study of a line that measures it wrong) keeps it.
   base.eol_curve = scenario.plant.curve;
-  base.eol_friction_half_width_kN = scenario.plant.key_friction.half_width_kN;
-  base.eol_key_friction = scenario.plant.key_friction;
+  if (!base.eol_key_friction) base.eol_key_friction = scenario.plant.key_friction;
+  base.eol_friction_half_width_kN = base.eol_key_friction->half_width_kN;
   return base;
 }
 

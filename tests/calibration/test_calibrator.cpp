@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "bbw/calibration/calibrator.hpp"
 #include "bbw/model/friction_tracker.hpp"
@@ -193,6 +194,53 @@ TEST(Calibrator, RestartedWithFittedStiffnessesItsFrictionIsFittedOnceItsStatesA
     }
   }
   EXPECT_TRUE(fitted_seen);
+}
+
+// Friction stiffnesses measured elsewhere (a caliper's end-of-line keys) held as the friction
+// memory's prior: cycles that modulate within 0.06 rev turn only the smallest elements round and
+// cannot tell the larger ones' friction from the curve. Without a prior (weight 0) their first fit
+// sets the amplitudes from what they could tell; with one, the measured keys stay where the cycles
+// had nothing to say, and the estimate follows the clamp force. Both report the friction as fitted
+// once the states are known.
+TEST(Calibrator, AFrictionPriorHoldsTheKeysThatNarrowCyclesCannotTell) {
+  auto c = base_config(Mode::Robust);
+  c.friction_memory = 0.9;
+  c.min_cycle_span_rev = 0.05;
+  const auto truth = truth_for(c);  // 0.15 kN on each of 6 elements, 0.3 rev down
+  Calibrator none(c), prior(c);
+  none.set_friction_prior(truth.k_kN_per_rev, 0.0);
+  prior.set_friction_prior(truth.k_kN_per_rev, 1000.0);
+  EXPECT_TRUE(prior.prior_friction_fitted());
+  std::vector<double> pos(truth.delta_rev.size(), 0.5);  // relaxed at 0.5 rev, as the calibrators assume
+  double worst_none_kN = 0.0, worst_prior_kN = 0.0;
+  const double dt = 0.001;
+  for (int k = 0; k < 14000; ++k) {
+    const double t = dt * k;
+    // Up to 3 rev in 2 s (every state known), then +/- 0.03 rev at 5 Hz.
+    const double x = t < 2.0 ? 0.5 + 1.25 * t : 3.0 + 0.03 * std::sin(2.0 * M_PI * 5.0 * (t - 2.0));
+    const double fric = bbw::model::elements_step(x, truth.delta_rev.data(), pos.data(), pos.size(),
+                                                  truth.k_kN_per_rev.data(), nullptr);
+    const double f_true = truth.curve.force_kN(x);
+    const Estimate a = none.update({t, x, f_true + fric});
+    const Estimate b = prior.update({t, x, f_true + fric});
+    if (t > 8.0) {
+      worst_none_kN = std::max(worst_none_kN, std::abs(a.force_kN - f_true));
+      worst_prior_kN = std::max(worst_prior_kN, std::abs(b.force_kN - f_true));
+      EXPECT_TRUE(a.friction_fitted && b.friction_fitted);
+    }
+  }
+  ASSERT_GE(none.stats().fits_accepted, 20u);
+  ASSERT_GE(prior.stats().fits_accepted, 20u);
+  double amplitude_none_kN = 0.0, amplitude_prior_kN = 0.0;
+  for (std::size_t i = 0; i < truth.delta_rev.size(); ++i) {
+    amplitude_none_kN += none.friction().stiffness_kN_per_rev[i] * truth.delta_rev[i];
+    amplitude_prior_kN += prior.friction().stiffness_kN_per_rev[i] * truth.delta_rev[i];
+  }
+  std::printf("keys 0.90 kN wide: %.3f kN fitted with the prior (worst estimate error %.3f kN), %.3f without (%.3f)\n",
+              amplitude_prior_kN, worst_prior_kN, amplitude_none_kN, worst_none_kN);
+  EXPECT_NEAR(amplitude_prior_kN, 0.9, 0.1);
+  EXPECT_LT(worst_prior_kN, 0.5 * worst_none_kN);
+  EXPECT_THROW(prior.set_friction_prior(truth.k_kN_per_rev, -1.0), std::invalid_argument);
 }
 
 // The delay line's newest value strictly before a time (what a resolver finding freezes: the

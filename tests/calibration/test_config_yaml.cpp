@@ -189,3 +189,43 @@ TEST(CalibratorConfigYaml, ShippedRobustWithEachEffectTermStateBytes) {
   // Issue 13: within 24 KiB with all five terms on too (the solver's Cholesky factor is packed).
   EXPECT_LE(with_all, 24u * 1024u) << with_all;
 }
+
+// A config written by to_yaml reads back to the same values (a CCU's per-corner start, with its
+// measured friction, handed to ./bbw calibrate); written again it is the same text.
+TEST(CalibratorConfigYaml, ToYamlReadsBackToTheSameConfig) {
+  auto c = load_config(source_dir() + "/config/calibrator/robust.yaml");
+  c.x_min_rev = 0.3141592653589793;
+  c.min_cycle_span_rev = 0.0671;
+  c.viscous_friction = true;
+  c.backlash_width_rev = 0.05;
+  c.initial_stiffness_kN_per_rev.assign(static_cast<std::size_t>(c.elements_M), 0.0);
+  for (std::size_t i = 0; i < c.initial_stiffness_kN_per_rev.size(); ++i) c.initial_stiffness_kN_per_rev[i] = 0.1 * i + 1e-3 / 3.0;
+  c.initial_viscous_kN_per_rev_per_s = 0.2;
+  c.initial_friction_weight = 50.0;
+  const std::string text = bbw::calibration::to_yaml(c);
+  auto r = bbw::config::Reader::from_string(text, "written");
+  const auto back = bbw::calibration::read_config(r);
+  r.finish();
+  EXPECT_EQ(back.x_min_rev, c.x_min_rev);
+  EXPECT_EQ(back.min_cycle_span_rev, c.min_cycle_span_rev);
+  EXPECT_EQ(back.initial_curve.a, c.initial_curve.a);
+  EXPECT_TRUE(back.viscous_friction);
+  EXPECT_EQ(back.backlash_width_rev, c.backlash_width_rev);
+  EXPECT_EQ(back.initial_stiffness_kN_per_rev, c.initial_stiffness_kN_per_rev);
+  EXPECT_EQ(back.initial_viscous_kN_per_rev_per_s, c.initial_viscous_kN_per_rev_per_s);
+  EXPECT_EQ(back.initial_friction_weight, c.initial_friction_weight);
+  EXPECT_EQ(bbw::calibration::to_yaml(back), text);
+}
+
+// The measured friction must match the elements: a count other than elements_M is refused with
+// its key and rule, as is a negative stiffness.
+TEST(CalibratorConfigYaml, InitialFrictionMustMatchTheElements) {
+  const std::string extra = "initial_friction:\n  stiffness_kN_per_rev: [1.0, 2.0]\n  weight: 50.0\n";
+  auto e = load_broken(robust_text() + extra);
+  EXPECT_EQ(e.key_path(), "initial_friction.stiffness_kN_per_rev");
+  EXPECT_NE(e.rule().find("must hold elements_M = 16 values, not 2"), std::string::npos) << e.rule();
+  std::string sixteen = "[-1.0";
+  for (int i = 1; i < 16; ++i) sixteen += ", 1.0";
+  e = load_broken(robust_text() + "initial_friction:\n  stiffness_kN_per_rev: " + sixteen + "]\n  weight: 50.0\n");
+  EXPECT_EQ(e.key_path(), "initial_friction.stiffness_kN_per_rev[0]");
+}

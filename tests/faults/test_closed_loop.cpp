@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <string>
 #include <limits>
 
 #include "closed_loop.hpp"
@@ -23,6 +24,20 @@ const Diagnosis& actuator(const LoopResult& r, std::size_t corner) {
 // ... and its load cell's.
 const Diagnosis& load_cell(const LoopResult& r, std::size_t corner) {
   return r.diagnoses[corner * 5 + static_cast<std::size_t>(Part::LoadCell)];
+}
+
+// The calibrator started as configured, as when the older rules were made: the shipped caliper's
+// range and elements, no key friction until its first fit, no load-dependent friction or play
+// terms (calibrator_start.range_, elements_, friction_, load_friction_ and backlash_from_end_of_
+// line), and the tracking rules counting only fitted friction. From the caliper's own start
+// several of the residuals those rules were made for no longer arise.
+void start_as_configured(MonitorParams& m) {
+  m.calibrator_range_from_eol = false;
+  m.calibrator_elements_from_eol = false;
+  m.calibrator_friction_from_eol = false;
+  m.calibrator_load_friction_from_eol = false;
+  m.calibrator_backlash_from_eol = false;
+  m.tracking_friction_as_subtracted = false;
 }
 
 // The campaign scenarios hold a stop from 10 s to 13 s and inject at 11 s.
@@ -871,7 +886,10 @@ TEST(ClosedLoopIssue14, KeysHoldingFrictionAtTheReleasedPositionAreNotABrakeThat
 TEST(ClosedLoopIssue14, AHoldRestartsAfterTheDriveLeftTheTrustedRange) {
   expect_quiet_only_with_the_rule("config/scenarios/faults/fault_free_slow_reversal_below_the_trusted_range.yaml",
                                   "the hold restarted below the trusted range", Finding::LoadCellOffset,
-                                  [](MonitorParams& m) { m.hold_restart_untrusted = false; });
+                                  [](MonitorParams& m) {
+                                    m.hold_restart_untrusted = false;
+                                    start_as_configured(m);
+                                  });
 }
 
 // A caliper ten times softer than the shipped one travels beyond 10 rev in hard stops (soft10_ff
@@ -1039,6 +1057,7 @@ TEST(ClosedLoopIssue14, ARestartedCalibratorsFrictionCountsOnceItsStatesAreKnown
     EXPECT_FALSE(actuator(r, c.corner).present) << c.scenario << ": " << to_string(actuator(r, c.corner).finding);
     auto opts = default_options();
     opts.monitor.tracking_friction_after_restart = false;
+    start_as_configured(opts.monitor);
     const auto base = run_closed_loop(fs, opts);
     EXPECT_EQ(actuator(base, c.corner).finding, Finding::ActuatorNotReleasing)
         << c.scenario << ": without the rule " << to_string(actuator(base, c.corner).finding);
@@ -1080,6 +1099,7 @@ TEST(ClosedLoopIssue14, AResolverFindingFreezesTheFrictionFromBeforeItsOnset) {
   // The friction from before the onset, uncounted: the keys' part of the shortfall is the actuator's.
   opts = default_options();
   opts.monitor.lost_resolver_tracking_counts_friction = false;
+  start_as_configured(opts.monitor);  // (started from the keys, the shortfall stays within the band)
   const auto uncounted = run_closed_loop(fs, opts);
   EXPECT_EQ(actuator(uncounted, rl).finding, Finding::ActuatorTracking) << to_string(actuator(uncounted, rl).finding);
   std::printf("RL after its resolver offset was named: worst |estimate - clamp force| %.2f kN with the friction from "
@@ -1106,6 +1126,7 @@ TEST(ClosedLoopIssue14, AViscousCalipersCalibratorFitsItsOwnViscousTerm) {
   EXPECT_EQ(r.faults_raised(), 1u);
   auto opts = default_options();
   opts.monitor.calibrator_viscous_from_eol = false;
+  start_as_configured(opts.monitor);  // (from the end-of-line keys as its prior: 3.9 kN off in the hard stop)
   const auto base = run_closed_loop(fs, opts);
   const double with_kN = worst_estimate_error_kN(r, fl, from_s, to_s);
   const double without_kN = worst_estimate_error_kN(base, fl, from_s, to_s);
@@ -1156,10 +1177,16 @@ TEST(ClosedLoopIssue14, TheEndOfLineBandAllowsForThePlayWhileItsStateIsUnknown) 
 TEST(ClosedLoopIssue14, TheEndOfLineModelFollowsALaggingLoadCell) {
   expect_quiet_only_with_the_rule("config/scenarios/faults/fault_free_soft_caliper_lagging_load_cell_in_abs.yaml",
                                   "the end-of-line model on the lagged position", Finding::LoadCellNoisy,
-                                  [](MonitorParams& m) { m.eol_delay_model = false; });
+                                  [](MonitorParams& m) {
+                                    m.eol_delay_model = false;
+                                    start_as_configured(m);
+                                  });
   expect_quiet_only_with_the_rule("config/scenarios/faults/fault_free_stiff_caliper_lagging_load_cell_in_abs.yaml",
                                   "the end-of-line model on the lagged position", Finding::LoadCellOffset,
-                                  [](MonitorParams& m) { m.eol_delay_model = false; });
+                                  [](MonitorParams& m) {
+                                    m.eol_delay_model = false;
+                                    start_as_configured(m);
+                                  });
 }
 
 // A hold's reference is set only from settle samples that lie within hold.settled_within_kN of
@@ -1195,7 +1222,10 @@ TEST(ClosedLoopIssue14, AMotorCreepingInsideThePlayIsNotALoadCellDrift) {
 TEST(ClosedLoopIssue14, ANoisyHealthyLoadCellReleasedLearnsItsOwnLevel) {
   expect_quiet_only_with_the_rule("config/scenarios/faults/fault_free_noisy_load_cell_released.yaml",
                                   "the noise paths restarting each other's learning", Finding::LoadCellNoisy,
-                                  [](MonitorParams& m) { m.noise_paths_restart_learning = false; });
+                                  [](MonitorParams& m) {
+                                    m.noise_paths_restart_learning = false;
+                                    start_as_configured(m);
+                                  });
 }
 
 // A drive seized as a hard stop applies (extreme hunt seed 2614, run 262): named, and nothing else.
@@ -1212,6 +1242,7 @@ TEST(ClosedLoopIssue14, KeysPullingALoadCellBelowZeroAreNotABrakeShortOfItsComma
   EXPECT_FALSE(actuator(r, fl).present) << to_string(actuator(r, fl).finding);
   auto opts = default_options();
   opts.monitor.tracking_shortfall_position_bound = false;
+  start_as_configured(opts.monitor);
   const auto base = run_closed_loop(fs, opts);
   EXPECT_EQ(actuator(base, fl).finding, Finding::ActuatorTracking) << to_string(actuator(base, fl).finding);
   std::printf("seized FR beside wide keys: FL %s with the bound, %s without\n", to_string(actuator(r, fl).finding),
@@ -1392,6 +1423,7 @@ TEST(ClosedLoopIssue14, AfterANamedTorqueLossTheTestsJudgeTheMotorThatIsLeft) {
   auto opts = default_options();
   opts.monitor.test_pulse_rescaled_after_loss = false;
   opts.monitor.calibrator_initial_curve_from_eol = false;  // (as when the rule was made)
+  start_as_configured(opts.monitor);
   const auto base = run_closed_loop(fs, opts);
   const auto named_lost = [](const LoopResult& x) {
     for (const auto& d : x.diagnoses) {
@@ -1424,4 +1456,98 @@ TEST(ClosedLoopIssue14, TheMovingStepRuleLetsTheFrictionVanishWhileTheResolverIs
   ASSERT_EQ(b.outcomes.size(), 2u);
   for (const auto& o : b.outcomes) EXPECT_TRUE(o.detected) << to_string(o.fault.type) << " " << to_string(o.diagnosis);
   EXPECT_EQ(b.faults_raised(), 2u);
+}
+
+namespace {
+
+// Each corner's RMS |estimate - clamp force| from from_s on (the periods the CCU estimated).
+std::array<double, kCorners> estimate_rms_kN(const LoopResult& r, double from_s) {
+  std::array<double, kCorners> sum{}, n{};
+  for (const auto& p : r.periods) {
+    if (p.time_s < from_s) continue;
+    for (std::size_t c = 0; c < kCorners; ++c) {
+      if (!std::isfinite(p.true_kN[c]) || !std::isfinite(p.estimate_kN[c])) continue;
+      const double e = p.estimate_kN[c] - p.true_kN[c];
+      sum[c] += e * e;
+      n[c] += 1.0;
+    }
+  }
+  std::array<double, kCorners> rms{};
+  for (std::size_t c = 0; c < kCorners; ++c) rms[c] = n[c] > 0.0 ? std::sqrt(sum[c] / n[c]) : std::numeric_limits<double>::infinity();
+  return rms;
+}
+
+}  // namespace
+
+// Slow ramps on calipers three to ten times stiffer (stiff10_ff run 17), FR with load-dependent
+// keys and RR with play: no hysteresis cycle until the end, so no calibrator fits before it, and the
+// estimate was the load cell as it is, keys and all (2.8-3.7 kN RMS off). Started from each
+// caliper's end-of-line keys, their growth with the load and the play (calibrator_start.friction_,
+// load_friction_ and backlash_from_end_of_line), every corner's estimate is within a few tenths of
+// a kN. Before the pads touched, the corners' load-cell loops stood on 3.6-3.8 kN of keys with the
+// clamp force at 0: that is no actuator failing to track once the tracking rules count the friction
+// the estimate took out (tracking.friction_as_subtracted); without, FL and FR were named.
+TEST(ClosedLoopIssue14, ANeverFittedCalibratorStartsFromTheCalipersOwnKeys) {
+  const char* scenario = "config/scenarios/faults/fault_free_stiff_calipers_slow_ramps_never_fitted.yaml";
+  const auto fs = load(scenario);
+  const auto r = run_closed_loop(fs, default_options());
+  auto opts = default_options();
+  opts.monitor.calibrator_friction_from_eol = false;
+  opts.monitor.calibrator_load_friction_from_eol = false;
+  opts.monitor.calibrator_backlash_from_eol = false;
+  const auto raw = run_closed_loop(fs, opts);
+  const auto with = estimate_rms_kN(r, 1.0), without = estimate_rms_kN(raw, 1.0);
+  for (std::size_t c = 0; c < kCorners; ++c) {
+    EXPECT_LE(r.fits[c], 1u) << "corner " << c;  // the premise: at most the end's one cycle to fit
+    EXPECT_LT(with[c], 0.3) << "corner " << c;
+    EXPECT_GT(without[c], 2.0) << "corner " << c;
+    std::printf("corner %zu: estimate %.3f kN RMS from the end-of-line keys, %.3f from the load cell as it is\n", c,
+                with[c], without[c]);
+  }
+  expect_quiet_only_with_the_rule(scenario, "the tracking rules counting the friction taken out",
+                                  Finding::ActuatorTracking,
+                                  [](MonitorParams& m) { m.tracking_friction_as_subtracted = false; });
+}
+
+// The simulated end-of-line test measures each caliper's keys exactly; a real line would not. With
+// a measurement that is wrong in every way the keys' model has (another draw of the elements, their
+// thresholds 1.5 x too wide and their force 25 % too high), the calibrators still start far closer
+// to the clamp force than the load cell as it is, on the shipped fault-free stop (where the fits
+// move the keys toward what the cycles show) and on the stiff calipers' slow ramps (where nothing
+// is fitted). The shipped stop raises nothing. (The stiff calipers' ramps raise load_cell_offset on
+// FL and FR: the residual rules' end-of-line key model, not the calibrator's start, takes the
+// measurement as exact; started as configured they raise the same two.)
+TEST(ClosedLoopIssue14, AnEndOfLineKeyMeasurementThatIsWrongStillBeatsTheLoadCellAsItIs) {
+  for (const char* scenario : {"config/scenarios/faults/fault_free_stop.yaml",
+                               "config/scenarios/faults/fault_free_stiff_calipers_slow_ramps_never_fitted.yaml"}) {
+    const bool shipped = std::string(scenario).find("fault_free_stop") != std::string::npos;
+    const auto fs = load(scenario);
+    auto wrong = fs.scenario.plant.key_friction;
+    wrong.structure_seed += 1;
+    wrong.half_width_kN *= 1.25;
+    wrong.threshold_median_rev *= 1.5;
+    wrong.threshold_min_rev *= 1.5;
+    wrong.threshold_max_rev *= 1.5;
+    auto opts = default_options();
+    opts.monitor.eol_key_friction = wrong;
+    const auto r = run_closed_loop(fs, opts);
+    if (shipped) {
+      EXPECT_EQ(r.faults_raised(), 0u) << scenario;
+    }
+    for (std::size_t i = 0; i < r.diagnoses.size(); ++i) {
+      if (r.diagnoses[i].present) {
+        std::printf("  raised: corner %zu %s at %.3f s\n", i / 5, to_string(r.diagnoses[i].finding), r.diagnoses[i].detected_s);
+      }
+    }
+    auto raw_opts = default_options();
+    start_as_configured(raw_opts.monitor);
+    const auto raw = run_closed_loop(fs, raw_opts);
+    const auto exact = run_closed_loop(fs, default_options());
+    const auto with = estimate_rms_kN(r, 1.0), without = estimate_rms_kN(raw, 1.0), right = estimate_rms_kN(exact, 1.0);
+    for (std::size_t c = 0; c < kCorners; ++c) {
+      EXPECT_LT(with[c], 0.5 * without[c]) << scenario << " corner " << c;
+      std::printf("%s corner %zu: estimate %.3f kN RMS from a wrong end-of-line measurement, %.3f from the right one, "
+                  "%.3f started as configured\n", scenario, c, with[c], right[c], without[c]);
+    }
+  }
 }

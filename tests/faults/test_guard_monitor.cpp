@@ -719,7 +719,11 @@ TEST(FaultMonitor, AnExcessTheCalibratedKeyFrictionExplainsIsNotABrakeThatDoesNo
   const Diagnosis seized = run(10.0, true);  // the load cell stayed up with the force: 3.5 kN over
   ASSERT_TRUE(seized.present);
   EXPECT_EQ(seized.finding, Finding::ActuatorNotReleasing);
-  // Before a fit the friction is not known: the 3.5 kN excess counts as before.
+  // Before a fit the friction the estimate took out counts too (a calibrator started from the
+  // caliper's end-of-line keys takes it out from the first sample: tracking.friction_as_subtracted).
+  EXPECT_FALSE(run(6.5, false).present);
+  // Counting only fitted friction, the 3.5 kN excess counts as the brake's.
+  p.tracking_friction_as_subtracted = false;
   const Diagnosis uncalibrated = run(6.5, false);
   ASSERT_TRUE(uncalibrated.present);
   EXPECT_EQ(uncalibrated.finding, Finding::ActuatorNotReleasing);
@@ -730,6 +734,7 @@ TEST(FaultMonitor, AnExcessTheCalibratedKeyFrictionExplainsIsNotABrakeThatDoesNo
 // its friction counts (tracking.friction_after_restart); without the rule, only after its own fit.
 TEST(FaultMonitor, ARestartedCalibratorsFittedFrictionExplainsAnExcess) {
   MonitorParams p = noiseless();
+  p.tracking_friction_as_subtracted = false;  // (the rule on its own: with it, any friction taken out counts)
   SampleCheck ok;
   auto run = [&](bool friction_fitted) {
     FaultMonitor m(p, Target::FL);

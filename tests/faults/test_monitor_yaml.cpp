@@ -45,7 +45,7 @@ TEST(MonitorYaml, TheShippedFileIsTheMonitorsDefaults) {
   SAME(guard.position_min_rev); SAME(guard.position_max_rev); SAME(guard.speed_abs_max_rev_per_s);
   SAME(guard.load_cell_min_kN); SAME(guard.load_cell_max_kN); SAME(guard.current_abs_max_A);
   SAME(guard.max_sequence_jump); SAME(guard.max_time_jump_s); SAME(guard_position_from_eol); SAME(guard_diagnosed_load_cell_absent);
-  SAME(lost_load_cell_curve_from_eol); SAME(calibrator_initial_curve_from_eol); SAME(calibrator_viscous_from_eol); SAME(lost_resolver_friction_before_onset); SAME(lost_resolver_tracking_counts_friction);
+  SAME(lost_load_cell_curve_from_eol); SAME(calibrator_initial_curve_from_eol); SAME(calibrator_viscous_from_eol); SAME(calibrator_load_friction_from_eol); SAME(calibrator_backlash_from_eol); SAME(calibrator_range_from_eol); SAME(calibrator_elements_from_eol); SAME(calibrator_friction_from_eol); SAME(calibrator_friction_prior_weight); SAME(tracking_friction_as_subtracted); SAME(lost_resolver_friction_before_onset); SAME(lost_resolver_tracking_counts_friction);
   SAME(residual_threshold_kN); SAME(uncalibrated_residual_threshold_kN); SAME(residual_persist_s);
   SAME(residual_reference_s); SAME(residual_change_threshold_kN); SAME(curve_min_rev); SAME(curve_max_rev);
   SAME(residual_on_profile_corners); SAME(residual_findings); SAME(residual_low_upper_bound); SAME(residual_low_lower_bound); SAME(residual_low_static_span_rev);

@@ -20,6 +20,7 @@
 #include "bbw/calibration/offline.hpp"
 #include "bbw/common/csv.hpp"
 #include "bbw/faults/corner_supervisor.hpp"
+#include "bbw/node/ccu_core.hpp"
 #include "bbw/scenario/load.hpp"
 #include "bbw/runtime/child.hpp"
 #include "bbw/runtime/run_stats.hpp"
@@ -145,25 +146,23 @@ TEST(SystemLockstep, CcuEstimatesEqualOfflineCalibration) {
   const std::string dir = scratch("offline");
   const ProcessRun r = launch("tests/system/data/short_rig.yaml", dir, 163, "lockstep");
   ASSERT_TRUE(r.status.ok()) << r.status.describe() << "\n" << r.err;
-  // The CCU starts each calibrator from its caliper's end-of-line curve (the scenario's plant
-  // curve; calibrator_start.initial_curve_from_end_of_line): offline starts from the same.
-  bbw::faults::MonitorParams eol;
-  eol.eol_curve = bbw::scenario::load_scenario(src("tests/system/data/short_rig.yaml")).plant.curve;
-  const auto config = bbw::faults::calibrator_start(bbw::calibration::load_config(src("config/calibrator/robust.yaml")), eol);
-  // The same for ./bbw calibrate: the configured file with that initial curve (at full precision).
-  std::string config_text = slurp(src("config/calibrator/robust.yaml"));
-  {
-    const auto at = config_text.find("initial_curve:");
-    const auto end = config_text.find("accept:", at);
-    ASSERT_TRUE(at != std::string::npos && end != std::string::npos);
-    char curve[256];
-    std::snprintf(curve, sizeof curve, "initial_curve:\n  a_kN_per_rev3: %.17g\n  b_kN_per_rev2: %.17g\n  c_kN_per_rev: %.17g\n  d_kN: %.17g\n",
-                  config.initial_curve.a, config.initial_curve.b, config.initial_curve.c, config.initial_curve.d);
-    config_text.replace(at, end - at, curve);
-  }
-  const std::string config_file = dir + "/robust_from_end_of_line.yaml";
-  std::ofstream(config_file) << config_text;
+  // The CCU starts each corner's calibrator from its caliper's end-of-line test (the scenario's
+  // plant: its curve, its keys, its position constants; faults::calibrator_start with the corner's
+  // monitor parameters): offline starts from the same, and so does ./bbw calibrate, given that
+  // start as a config file (calibration::to_yaml, every number at full precision).
+  const auto scenario = bbw::scenario::load_scenario(src("tests/system/data/short_rig.yaml"));
+  const auto base = bbw::calibration::load_config(src("config/calibrator/robust.yaml"));
+  const auto start_of = [&](std::size_t corner) {
+    return bbw::faults::calibrator_start(
+        base, bbw::ccu::corner_monitor_params(scenario, corner, bbw::ccu::monitor_params_for(scenario)));
+  };
   for (const char* c : {"FL", "RR"}) {
+    const std::size_t corner = std::string(c) == "FL" ? 0 : 3;
+    ASSERT_EQ(scenario.corners.at(corner).name, c);
+    const auto config = start_of(corner);
+    ASSERT_FALSE(config.initial_stiffness_kN_per_rev.empty()) << "the CCU's start has the caliper's keys";
+    const std::string config_file = dir + "/robust_from_end_of_line_" + std::string(c) + ".yaml";
+    std::ofstream(config_file) << bbw::calibration::to_yaml(config);
     bbw::csv::ReadOptions o;
     o.required = {"time_s", "position_rev", "force_internal_kN", "estimate_kN", "friction_kN", "curve_kN"};
     const auto log = bbw::csv::read(dir + "/out/ccu_" + std::string(c) + ".csv", o);

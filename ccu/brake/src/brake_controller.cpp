@@ -128,11 +128,18 @@ const BrakeOutput& BrakeController::update(double dt_s, const BrakeMeasurements&
   // tyres carry what the brakes apply), the tyres' braking forces (the slip controllers' last
   // R Fx = T + I dw/dt, through the loads they were given) and the driving resistance over the
   // measured deceleration.
+  // The tyres' forces below are the slip controllers' of the last period, made from the clamp-force
+  // estimates they had then, themselves a period old (the corners' last samples): the deceleration
+  // they are divided by is the one of two periods ago. Divided by the present one, the apply ramp
+  // (where the estimate runs before slip control takes the wheels) read a car of 1393 kg as 1299.
+  ax_mass_filt_ += std::min(1.0, dt_s / 0.03) * (ax_past_m_s2_[1] - ax_mass_filt_);
+  ax_past_m_s2_[1] = ax_past_m_s2_[0];
+  ax_past_m_s2_[0] = m.ax_m_s2;
   if (p_.mass.enabled && !any_active && z_request > 0.0 && -ax_filt_ > p_.mass.min_decel_g * kG && v > p_.slip.min_speed_m_s) {
     double fx_N = 0.0;
     for (std::size_t w = 0; w < 4; ++w) fx_N += m.available[w] ? slip_[w].last().mu_estimate * load_in_N_[w] : 0.0;
     const double resistance_N = c.drag_N_s2_per_m2 * v * v + c.rolling_resistance * mass_kg_ * kG;
-    const double raw_kg = std::clamp((fx_N + resistance_N) / -ax_filt_, c.mass_kg, p_.mass.max_factor * c.mass_kg);
+    const double raw_kg = std::clamp((fx_N + resistance_N) / -std::min(ax_mass_filt_, -1e-3), c.mass_kg, p_.mass.max_factor * c.mass_kg);
     mass_kg_ += std::min(1.0, dt_s / p_.mass.time_constant_s) * (raw_kg - mass_kg_);
   }
   const double mass = mass_used_kg();

@@ -140,6 +140,10 @@ Calibrator::Calibrator(const CalibratorConfig& config)
     info_kN_.assign(q * (q + 1) / 2, 0.0f);
     info_rhs_kN_.assign(q, 0.0);
   }
+  if (!config.initial_stiffness_kN_per_rev.empty()) {
+    set_friction_prior(config.initial_stiffness_kN_per_rev, config.initial_friction_weight,
+                       config.initial_viscous_kN_per_rev_per_s);
+  }
 }
 
 std::size_t Calibrator::state_bytes() const {
@@ -168,6 +172,34 @@ void Calibrator::set_friction_stiffness(const std::vector<double>& k_kN_per_rev,
     phi_kN_[i] = k_kN_per_rev[i] * friction_.delta_rev[i];
   }
   prior_friction_fitted_ = from_fits;
+}
+
+void Calibrator::set_friction_prior(const std::vector<double>& k_kN_per_rev, double weight,
+                                    double viscous_kN_per_rev_per_s) {
+  if (!(weight >= 0.0) || !std::isfinite(weight)) {
+    throw std::invalid_argument("set_friction_prior: weight must be finite and >= 0, got " + std::to_string(weight));
+  }
+  if (!(viscous_kN_per_rev_per_s >= 0.0) || !std::isfinite(viscous_kN_per_rev_per_s)) {
+    throw std::invalid_argument("set_friction_prior: viscous coefficient must be finite and >= 0, got " +
+                                std::to_string(viscous_kN_per_rev_per_s));
+  }
+  set_friction_stiffness(k_kN_per_rev, true);
+  // The viscous column is the first after the elements (effect_columns).
+  const auto viscous = static_cast<std::size_t>(m_);
+  if (config_.viscous_friction) {
+    phi_kN_[viscous] = viscous_kN_per_rev_per_s * config_.viscous_speed_scale_rev_per_s;
+    friction_.viscous_kN_per_rev_per_s = viscous_kN_per_rev_per_s;
+  }
+  if (info_rhs_kN_.empty()) return;  // no friction memory: no prior to hold
+  const std::size_t q = info_rhs_kN_.size();
+  std::fill(info_kN_.begin(), info_kN_.end(), 0.0f);
+  std::fill(info_rhs_kN_.begin(), info_rhs_kN_.end(), 0.0);
+  for (std::size_t a = 0, t = 0; a < q; t += q - a, ++a) {
+    // The elements and the viscous term (the other effect columns keep none).
+    if (a > viscous || (a == viscous && !config_.viscous_friction)) break;
+    info_kN_[t] = static_cast<float>(weight);  // (a, a): the first of row a's upper triangle
+    info_rhs_kN_[a] = weight * phi_kN_[a];
+  }
 }
 
 double Calibrator::poly_basis_x(double x_rev, int power) const {
@@ -611,19 +643,34 @@ Estimate Calibrator::update(const Sample& s) {
   if (delayed) e.force_kN += e.curve_force_kN - curve_.force_kN(x);
   if (residual_kN_.size() > 1) {
     // f_hat = C(x_now) + mean of the last residuals; a new curve restarts the mean (the stored
-    // residuals were taken against the old one).
+    // residuals were taken against the old one). Outside the curve's range the residuals are not
+    // carried along its cubic, whose extrapolation is steep there: residuals four samples back,
+    // carried by it, were 27 kN off in a 12 rev/s release (stiff10_ff run 12, RR); along its tangent
+    // 10 kN. Below the range they are carried flat (the pads open, the clamp force flattens out:
+    // the error is at most its change over the window), above it along the tangent at the end (the
+    // clamp force keeps rising; the cubic need not).
     if (e.fit_accepted) residual_count_ = 0;
+    const double carried_kN = carrying_curve_kN(x_now);
     const std::size_t w = residual_kN_.size();
     residual_head_ = (residual_head_ + 1) % w;
-    residual_kN_[residual_head_] = e.force_kN - e.curve_force_kN;
+    residual_kN_[residual_head_] = e.force_kN - carried_kN;
     if (residual_count_ < w) ++residual_count_;
     double sum = 0.0;
     for (std::size_t k = 0; k < residual_count_; ++k) sum += residual_kN_[(residual_head_ + w - k) % w];
-    e.force_kN = e.curve_force_kN + sum / static_cast<double>(residual_count_);
+    e.force_kN = carried_kN + sum / static_cast<double>(residual_count_);
   }
   e.calibrated = stats_.fits_accepted > 0;
   e.friction_fitted = states_known_ && (e.calibrated || prior_friction_fitted_);
   return e;
+}
+
+double Calibrator::carrying_curve_kN(double x_rev) const {
+  const double lo = config_.x_min_rev, hi = config_.x_max_rev;
+  if (x_rev < lo) return curve_.force_kN(lo);
+  if (x_rev <= hi) return curve_.force_kN(x_rev);
+  const Curve& c = curve_;
+  const double slope = (3.0 * c.a * hi + 2.0 * c.b) * hi + c.c;
+  return c.force_kN(hi) + slope * (x_rev - hi);
 }
 
 void Calibrator::note_curve_data(double x_lo_rev, double x_hi_rev) {

@@ -77,6 +77,20 @@ void CalibratorConfig::validate() const {
   if (!(friction_memory >= 0.0 && friction_memory <= 1.0)) bad("friction_memory", friction_memory, "must be in [0, 1]");
   if (!(max_fit_rms_kN > 0.0)) bad("max_fit_rms_kN", max_fit_rms_kN, "must be > 0");
   if (!(start_margin_rev >= 0.0)) bad("start_margin_rev", start_margin_rev, "must be >= 0");
+  if (!initial_stiffness_kN_per_rev.empty() &&
+      initial_stiffness_kN_per_rev.size() != static_cast<std::size_t>(elements_M)) {
+    bad("initial_friction.stiffness_kN_per_rev", static_cast<double>(initial_stiffness_kN_per_rev.size()),
+        "must hold elements_M values (entries given)");
+  }
+  for (double k : initial_stiffness_kN_per_rev) {
+    if (!(k >= 0.0) || !std::isfinite(k)) bad("initial_friction.stiffness_kN_per_rev", k, "must be finite and >= 0");
+  }
+  if (!(initial_viscous_kN_per_rev_per_s >= 0.0) || !std::isfinite(initial_viscous_kN_per_rev_per_s)) {
+    bad("initial_friction.viscous_kN_per_rev_per_s", initial_viscous_kN_per_rev_per_s, "must be finite and >= 0");
+  }
+  if (!(initial_friction_weight >= 0.0) || !std::isfinite(initial_friction_weight)) {
+    bad("initial_friction.weight", initial_friction_weight, "must be finite and >= 0");
+  }
   if (velocity_window < 2 || velocity_window > 1000) bad("velocity_window", velocity_window, "must be in [2, 1000]");
   if (const auto e = check_effect_terms(effect_values())) bad(e.bound->key, e.value, rule_of(*e.bound).c_str());
   if (!(k_smoothing > 0.0 && k_smoothing <= 1.0)) bad("k_smoothing", k_smoothing, "must be in (0, 1]");

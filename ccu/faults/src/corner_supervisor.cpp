@@ -1,6 +1,7 @@
 #include "bbw/faults/corner_supervisor.hpp"
 
 #include "bbw/faults/bridged_curve.hpp"
+#include "bbw/plant/key_friction.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -42,6 +43,32 @@ calibration::CalibratorConfig accepting(calibration::CalibratorConfig c, const M
   return c;
 }
 
+// The caliper's measured key friction on a calibrator's thresholds: each element's force share
+// K Delta split between the two thresholds around its own in log spacing (beyond the ends: the
+// end one's), returned as the calibrator's K_i (kN/rev).
+std::vector<double> eol_friction_stiffness(const calibration::CalibratorConfig& c, const plant::KeyFrictionParams& k) {
+  const std::vector<double> delta = calibration::friction_thresholds_rev(c);  // smallest first
+  std::vector<double> share_kN(delta.size(), 0.0);
+  const plant::KeyFriction keys(k);
+  const auto& thresholds = keys.thresholds_rev();
+  const auto& stiffness = keys.stiffness_kN_per_rev();
+  for (std::size_t j = 0; j < thresholds.size() && !delta.empty(); ++j) {
+    const double d = thresholds[j], share = stiffness[j] * thresholds[j];
+    if (d <= delta.front()) {
+      share_kN.front() += share;
+    } else if (d >= delta.back()) {
+      share_kN.back() += share;
+    } else {
+      const auto hi = static_cast<std::size_t>(std::upper_bound(delta.begin(), delta.end(), d) - delta.begin());
+      const double w = std::log(d / delta[hi - 1]) / std::log(delta[hi] / delta[hi - 1]);
+      share_kN[hi - 1] += (1.0 - w) * share;
+      share_kN[hi] += w * share;
+    }
+  }
+  for (std::size_t i = 0; i < delta.size(); ++i) share_kN[i] /= delta[i];
+  return share_kN;
+}
+
 }  // namespace
 
 // The calibrator's starting curve: with an end-of-line curve (and calibrator_start.initial_curve_
@@ -52,9 +79,49 @@ calibration::CalibratorConfig accepting(calibration::CalibratorConfig c, const M
 calibration::CalibratorConfig calibrator_start(calibration::CalibratorConfig c, const MonitorParams& m) {
   // A drive whose viscous friction the end-of-line test measured: the calibrator fits its own.
   if (m.calibrator_viscous_from_eol && m.eol_curve && m.eol_viscous_kN_per_rev_per_s > 0.0) c.viscous_friction = true;
+  // Its keys' growth with the load and its play likewise (within the calibrator's terms' bounds).
+  if (m.calibrator_load_friction_from_eol && m.eol_curve && m.eol_friction_load_gain > 0.0) {
+    c.load_friction_gain = std::min(m.eol_friction_load_gain, model::LoadFrictionTerm::gain.max);
+    c.load_friction_reference_kN = m.eol_friction_reference_kN;
+  }
+  if (m.calibrator_backlash_from_eol && m.eol_curve && m.eol_backlash_rev > 0.0) {
+    c.backlash_width_rev = std::min(m.eol_backlash_rev, model::BacklashTerm::width.max);
+  }
+  // Elements from the caliper's largest key threshold down (the configured delta_max the most).
+  if (m.calibrator_elements_from_eol && m.eol_key_friction) {
+    const plant::KeyFriction keys(*m.eol_key_friction);
+    const auto& thresholds = keys.thresholds_rev();
+    const double largest_rev = thresholds.empty() ? 0.0 : *std::max_element(thresholds.begin(), thresholds.end());
+    if (largest_rev > 0.0) c.delta_max_rev = std::min(c.delta_max_rev, largest_rev);
+  }
+  // Its measured keys (and viscous friction) as its start and its fits' prior, on its thresholds.
+  if (m.calibrator_friction_from_eol && m.eol_key_friction && c.elements_M > 0) {
+    c.initial_stiffness_kN_per_rev = eol_friction_stiffness(c, *m.eol_key_friction);
+    c.initial_viscous_kN_per_rev_per_s = c.viscous_friction ? m.eol_viscous_kN_per_rev_per_s : 0.0;
+    c.initial_friction_weight = m.calibrator_friction_prior_weight;
+  }
   // (An empty range is the calibrator's to refuse, with its own message.)
-  if (!m.calibrator_initial_curve_from_eol || !m.eol_curve || !(c.x_max_rev > c.x_min_rev)) return c;
+  if (!m.eol_curve || !(c.x_max_rev > c.x_min_rev)) return c;
   const plant::ClampCurve eol(*m.eol_curve);
+  if (m.calibrator_range_from_eol) {
+    // The forces the configured initial curve clamps at the range's ends, found on this caliper.
+    const double t_C = m.eol_curve->reference_temperature_C;
+    const double f_lo_kN = c.initial_curve.force_kN(c.x_min_rev), f_hi_kN = c.initial_curve.force_kN(c.x_max_rev);
+    const double lo_rev = eol_position_at(eol, f_lo_kN, t_C, 0.0, 1000.0);
+    const double hi_rev = eol_position_at(eol, f_hi_kN, t_C, lo_rev, 1000.0);
+    // Only ever narrowed: over a wider range one cubic cannot follow a soft caliper's exponential
+    // rise (a caliper 0.4 x as stiff, range 2.3-9.4 rev: its fitted curve 3 kN high at 7.7 rev,
+    // ClosedLoopIssue14.ASoftCalipersLostLoadCellLeavesACurveThatFollowsItsClampForce); beyond the
+    // range the end-of-line curve carries it (bridge_curve).
+    const double scale = (hi_rev - lo_rev) / (c.x_max_rev - c.x_min_rev);
+    if (f_hi_kN > f_lo_kN && hi_rev > lo_rev && scale < 1.0) {
+      c.min_cycle_span_rev *= scale;
+      c.start_margin_rev *= scale;
+      c.x_min_rev = lo_rev;
+      c.x_max_rev = hi_rev;
+    }
+  }
+  if (!m.calibrator_initial_curve_from_eol) return c;
   c.initial_curve = bridge_curve(c.initial_curve, DataSpan{}, eol, m.eol_curve->reference_temperature_C, c.x_min_rev,
                                  c.x_max_rev);
   return c;

@@ -361,9 +361,10 @@ void FaultMonitor::update(const CornerReading& r, const SampleCheck& check, cons
   if (commutation_lost()) {
     tracking_.on_rejoin();
   } else {
-    const bool fitted = estimate != nullptr && (p_.tracking_friction_after_restart ? estimate->friction_fitted : estimate->calibrated);
+    const bool counts = estimate != nullptr && (p_.tracking_friction_as_subtracted ||
+                                                (p_.tracking_friction_after_restart ? estimate->friction_fitted : estimate->calibrated));
     const bool lc_trusted = check.load_cell_present && arbiter_.ok(Part::LoadCell);
-    double friction_kN = fitted && estimate->valid && lc_trusted ? estimate->friction_kN : 0.0;
+    double friction_kN = counts && estimate->valid && lc_trusted ? estimate->friction_kN : 0.0;
     if (estimate == nullptr && lc_trusted && p_.lost_resolver_tracking_counts_friction && std::isfinite(load_cell_friction_kN)) {
       friction_kN = load_cell_friction_kN;
     }

@@ -7,7 +7,8 @@ namespace bbw::faults {
 LastGoodCalibration::LastGoodCalibration(const calibration::Calibrator& initial) {
   const std::size_t m = initial.friction().stiffness_kN_per_rev.size();
   initial_.curve = initial.config().initial_curve;
-  initial_.stiffness_kN_per_rev.assign(m, 0.0);
+  initial_.stiffness_kN_per_rev = initial.friction().stiffness_kN_per_rev;  // (zero unless it was given a start)
+  initial_.from_fit = initial.prior_friction_fitted();
   for (auto& s : ring_) s.stiffness_kN_per_rev.assign(m, 0.0);
 }
 

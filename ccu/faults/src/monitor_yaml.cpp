@@ -168,6 +168,12 @@ MonitorParams read_monitor_params(Reader& r) {
   auto start = r.map("calibrator_start");
   p.calibrator_initial_curve_from_eol = start.boolean("initial_curve_from_end_of_line");
   p.calibrator_viscous_from_eol = start.boolean("viscous_term_from_end_of_line");
+  p.calibrator_load_friction_from_eol = start.boolean("load_friction_from_end_of_line");
+  p.calibrator_backlash_from_eol = start.boolean("backlash_from_end_of_line");
+  p.calibrator_range_from_eol = start.boolean("range_from_end_of_line");
+  p.calibrator_elements_from_eol = start.boolean("elements_from_end_of_line");
+  p.calibrator_friction_from_eol = start.boolean("friction_from_end_of_line");
+  p.calibrator_friction_prior_weight = start.number("friction_prior_weight", Range::non_negative());
   start.finish();
 
   auto lost_resolver = r.map("resolver_lost");
@@ -226,6 +232,7 @@ MonitorParams read_monitor_params(Reader& r) {
   p.tracking_excess_position_bound = k.boolean("excess_position_bound");
   p.tracking_shortfall_position_bound = k.boolean("shortfall_position_bound");
   p.tracking_friction_after_restart = k.boolean("friction_after_restart");
+  p.tracking_friction_as_subtracted = k.boolean("friction_as_subtracted");
   p.force_limit_kN = k.number("force_limit_kN", pos);
   p.release_min_speed_rev_per_s = k.number("release_min_speed_rev_per_s", pos);
   k.finish();

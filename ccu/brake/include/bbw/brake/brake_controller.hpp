@@ -66,6 +66,8 @@ class BrakeController {
   SpeedEstimator speed_;
   std::array<SlipController, 4> slip_;
   double ax_filt_ = 0.0;
+  std::array<double, 2> ax_past_m_s2_{};  // the last two periods' decelerations, newest first
+  double ax_mass_filt_ = 0.0;            // the one two periods ago, through ax_filt_'s filter
   double mass_kg_ = 0.0;                // the mass estimate (MassEstimateParams), from the nominal mass
   std::array<double, 4> load_in_N_{};   // the loads the slip controllers were given last period
   std::array<double, 4> pads_off_s_{};  // how long each wheel's pads have been off the disc (WheelBrakeStatus)

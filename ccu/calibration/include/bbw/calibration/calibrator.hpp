@@ -35,8 +35,8 @@ struct Estimate {
   bool valid = false;           // false when the sample was rejected (NaN, out of range, time backwards)
   bool calibrated = false;      // true once at least one cycle fit was accepted
   // The friction term is a fitted one where the keys are: its K_i come from accepted fits (this
-  // calibrator's, or those of the snapshot a restarted one was given, set_friction_stiffness(k,
-  // true)) and every element's state is known (the position has swept 2 Delta_max since the
+  // calibrator's, those of the snapshot a restarted one was given, or a caliper's measured ones:
+  // set_friction_stiffness(k, true)) and every element's state is known (the position has swept 2 Delta_max since the
   // start). A restarted calibrator has it before its first fit of its own (calibrated).
   bool friction_fitted = false;
   bool cycle_start = false;     // a new hysteresis cycle started at this sample
@@ -84,8 +84,20 @@ class Calibrator {
   // Restart from a known curve (e.g. a restarted corner's last good curve). Keeps stats and K_i.
   void reset_curve(const Curve& curve);
   // Friction stiffnesses from elsewhere (e.g. the last good state); sizes must match M.
-  // from_fits: they were fitted (Estimate::friction_fitted once the states are known).
+  // from_fits: they were fitted, or measured like a fit (a caliper's end-of-line key friction):
+  // Estimate::friction_fitted once the states are known.
   void set_friction_stiffness(const std::vector<double>& k_kN_per_rev, bool from_fits = false);
+  // Friction stiffnesses measured elsewhere (a caliper's end-of-line key friction), as
+  // set_friction_stiffness(k, true), and with friction memory also as its prior: each element's
+  // amplitude K_i Delta_i counts as `weight` of information (the sum of n_i^2 over a cycle's rows
+  // it would take to carry as much), forgotten by friction_memory per accepted fit like a cycle's.
+  // A cycle that cannot tell an element's friction from the curve (it never turned the element
+  // round) then leaves it at the measured value rather than at the ridge's 0. With the viscous term
+  // (CalibratorConfig::viscous_friction) its coefficient likewise, from viscous_kN_per_rev_per_s.
+  // Sizes must match M; weight >= 0 (0: no prior).
+  void set_friction_prior(const std::vector<double>& k_kN_per_rev, double weight, double viscous_kN_per_rev_per_s = 0.0);
+  // Whether the K_i it was given are such (set_friction_stiffness's from_fits).
+  bool prior_friction_fitted() const { return prior_friction_fitted_; }
   // Where the current curve already had data before this calibrator (a restart from a snapshot):
   // joined into Stats::curve_data_* as an accepted fit's span is. Ignored when empty (lo > hi).
   void note_prior_curve_data(double lo_rev, double hi_rev) { note_curve_data(lo_rev, hi_rev); }
@@ -108,6 +120,9 @@ class Calibrator {
   void refit_curve_from_pf();
   void regressor_row(double x_rev, const double* n, double* row) const;
   double poly_basis_x(double x_rev, int power) const;
+  // The curve the residual window carries its residuals along: the curve over [x_min, x_max], its
+  // value at x_min below (flat), its tangent at x_max above.
+  double carrying_curve_kN(double x_rev) const;
 
   CalibratorConfig config_;
   bool robust_;

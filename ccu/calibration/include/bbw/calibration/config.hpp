@@ -108,6 +108,15 @@ struct CalibratorConfig {
   double load_cell_offset_kN_per_C = 0.0;
   double load_cell_offset_reference_C = 40.0;
 
+  // Friction measured before any fit (a caliper's end-of-line keys, faults::calibrator_start):
+  // the elements' K_i (empty: none; else elements_M of them, each >= 0), the viscous coefficient
+  // (used with viscous_friction) and the weight the friction memory holds them with as its prior
+  // (Calibrator::set_friction_prior). The calibrator starts from them, its friction counting as
+  // fitted once the element states are known.
+  std::vector<double> initial_stiffness_kN_per_rev;
+  double initial_viscous_kN_per_rev_per_s = 0.0;
+  double initial_friction_weight = 0.0;
+
   // The effect terms' values (EffectTerms), as the calibrator is configured.
   EffectTermValues effect_values() const;
   // Regressor columns the effect terms add (effect_columns).

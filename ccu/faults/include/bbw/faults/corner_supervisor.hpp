@@ -49,10 +49,12 @@ struct CornerView {
   bool estimate_valid() const { return source != EstimateSource::None; }
 };
 
-// The calibrator config a corner's calibrator starts from: `c` with, when `m` has an end-of-line
-// curve and calibrator_initial_curve_from_eol, that caliper's own curve as its initial curve (a
-// cubic over c's range at the curve's reference temperature). Offline calibration that should
-// match a CCU's starts from the same (SystemLockstep.CcuEstimatesEqualOfflineCalibration).
+// The calibrator config a corner's calibrator starts from: `c` with what the caliper's end-of-line
+// test in `m` measured, each item under its own MonitorParams::calibrator_* switch: its curve as
+// the initial curve (a cubic over the range at the curve's reference temperature), its viscous,
+// load-friction and backlash terms, its range (only narrower) and largest element, and its keys as
+// initial_friction (the fits' prior). Offline calibration that should match a CCU's starts from
+// the same (SystemLockstep.CcuEstimatesEqualOfflineCalibration; calibration::to_yaml writes it).
 calibration::CalibratorConfig calibrator_start(calibration::CalibratorConfig c, const MonitorParams& m);
 
 class CornerSupervisor {

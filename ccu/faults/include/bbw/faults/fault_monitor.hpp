@@ -421,6 +421,39 @@ struct MonitorParams {
   // for key friction: 7.3-8.7 kN of friction on keys that hold 3.2-3.7 kN, the estimate 3.5-5.5 kN
   // off in holds (faster-driver campaign seed 3102 runs 27 and 267).
   bool calibrator_viscous_from_eol = true;
+  // Likewise its keys' friction growth with the clamp force (eol_friction_load_gain > 0: the
+  // calibrator's load_friction_gain and reference) and its play (eol_backlash_rev > 0: its
+  // backlash_width_rev). Without them, a calibrator started from the end-of-line keys
+  // (calibrator_friction_from_eol) left 1.4 kN of a load-dependent friction and 2.2 kN of keys
+  // acting across the play in its estimate (stiff10_ff run 17, FR and RR).
+  bool calibrator_load_friction_from_eol = true;
+  bool calibrator_backlash_from_eol = true;
+  // With an end-of-line curve, the calibrator's position constants are that caliper's, not the
+  // shipped one's: its range [x_min, x_max] becomes the positions where the caliper's end-of-line
+  // curve (at its reference temperature) clamps what the configured initial curve clamps at the
+  // configured range's ends, and the cycle span a curve update needs (min_cycle_span_rev) and the
+  // start detector's margin scale with that range. Only narrower ranges are taken (a cubic over a
+  // soft caliper's wider one misses its exponential rise by 3 kN; beyond the configured range the
+  // end-of-line curve carries a lost load cell's curve). Without it a caliper 3-10 x as stiff
+  // modulated within one cycle span and was never fitted (stiff10 campaign).
+  bool calibrator_range_from_eol = true;
+  // With an end-of-line key-friction measurement, the calibrator's largest element threshold
+  // (delta_max_rev) is the caliper's largest key threshold, when smaller than the configured one.
+  // The element states count as known once the position has moved twice delta_max one way: with
+  // the configured 0.8 rev, 68 of 100 corners of stiff calipers (travel 1.2-1.5 rev) never knew
+  // them and so never fitted (stiff10 campaign, first 25 runs).
+  bool calibrator_elements_from_eol = true;
+  // With an end-of-line key-friction measurement, the calibrator starts from that caliper's key
+  // friction: each measured element's force share K Delta on the calibrator's two nearest
+  // thresholds (split in log spacing), as K_i measured like a fit's (Estimate::friction_fitted
+  // once their states are known: the tracking rules count that friction). Its fits replace them; before the first, the estimate is the load cell less that
+  // friction instead of the load cell as it is (keys 0.3-4 kN wide in it; 11-16 of 100 corners
+  // of the stiff10 and soft10 campaigns and 14 of 79 of the tuning one never fit in 16-24 s).
+  bool calibrator_friction_from_eol = true;
+  // ... and holds it as its friction memory's prior of this weight (Calibrator::set_friction_
+  // prior: the information of that sum of n_i^2), so that cycles that cannot tell the keys from
+  // the curve leave them as measured (0: the first fit replaces them whatever it could tell).
+  double calibrator_friction_prior_weight = 50.0;
   // After a resolver finding the estimate is the load cell less the friction frozen at the
   // finding: the friction as it was before the fault's onset (the newest of the last
   // CornerSupervisor::kFrictionHistory samples older than it), not at the confirming sample. A
@@ -613,6 +646,14 @@ struct MonitorParams {
   // as a brake holding force (faster-driver campaign seed 3102 runs 27, 61, 101, 377: a healthy
   // corner named actuator_not_releasing in a slow release after the corner came back).
   bool tracking_friction_after_restart = true;
+  // The tracking rules count the friction the calibrator's estimate took out of the load cell
+  // whenever it took some, also while its element states are not known yet (a calibrator that
+  // starts from the caliper's end-of-line key friction, calibrator_friction_from_eol, takes it
+  // out from the first sample). Off: only where it is fitted (above); until then the estimate
+  // without the keys counted as the brake's whole force: a healthy corner whose load-cell loop
+  // stood on 3.6-3.8 kN of keys before the pads touched was named actuator_tracking (stiff10_ff
+  // campaign run 17, soft10_ff run 2).
+  bool tracking_friction_as_subtracted = true;
 
   // Link: no sample for this long is a lost link (the DDS deadline in the process).
   double deadline_s = 0.015;

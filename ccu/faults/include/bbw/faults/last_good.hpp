@@ -19,7 +19,7 @@ struct CalibrationSnapshot {
   double time_s = 0.0;
   calibration::Curve curve;
   std::vector<double> stiffness_kN_per_rev;  // K_i, size M (sized at construction)
-  bool from_fit = false;                     // false: the configured initial curve
+  bool from_fit = false;                     // false: the configured initial curve and K_i not measured
   DataSpan data;                             // where the fits up to it had data (empty: none)
 };
 
@@ -27,7 +27,8 @@ class LastGoodCalibration {
  public:
   static constexpr std::size_t kCapacity = 4;
 
-  // Starts with the calibrator's initial state (its initial curve, zero K_i) as the fallback.
+  // Starts with the calibrator's initial state (its initial curve and K_i: zero, or the start it was
+  // given, CornerSupervisor with calibrator_friction_from_eol) as the fallback.
   explicit LastGoodCalibration(const calibration::Calibrator& initial);
 
   // Stores the calibrator's current curve and K_i as of time_s, its fits' data over `data`.
