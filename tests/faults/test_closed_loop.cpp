@@ -1117,8 +1117,8 @@ TEST(ClosedLoopIssue14, AViscousCalipersCalibratorFitsItsOwnViscousTerm) {
   const auto fs = load("config/scenarios/faults/viscous_caliper_seized_in_a_hard_stop_of_a_fast_driver.yaml");
   const std::size_t fl = 0;
   // From its first fit (6.3 s) to the seized drive's release: holds, fast applies and releases,
-  // the hard stop and the seizure in it. (Before the first fit the estimate is the load cell, the
-  // same either way.)
+  // the hard stop and the seizure in it. (Before the first fit the estimate is the load cell less
+  // the end-of-line keys with the rule, the load cell as it is without: not compared.)
   const double from_s = 6.5, to_s = 15.7;
   const auto r = run_closed_loop(fs, default_options());
   ASSERT_EQ(r.outcomes.size(), 1u);

@@ -95,7 +95,7 @@ bbw::calibration::Estimate fitted(bool calibrated, double lc_kN, double friction
   return e;
 }
 
-// The calibrator before its first fit: the load cell as it is.
+// A calibrator before its first fit, started without the caliper's keys: the load cell as it is.
 bbw::calibration::Estimate uncalibrated(double lc) {
   bbw::calibration::Estimate e;
   e.valid = true;

@@ -446,9 +446,11 @@ struct MonitorParams {
   // With an end-of-line key-friction measurement, the calibrator starts from that caliper's key
   // friction: each measured element's force share K Delta on the calibrator's two nearest
   // thresholds (split in log spacing), as K_i measured like a fit's (Estimate::friction_fitted
-  // once their states are known: the tracking rules count that friction). Its fits replace them; before the first, the estimate is the load cell less that
-  // friction instead of the load cell as it is (keys 0.3-4 kN wide in it; 11-16 of 100 corners
-  // of the stiff10 and soft10 campaigns and 14 of 79 of the tuning one never fit in 16-24 s).
+  // once their states are known: the tracking rules count that friction), and its viscous
+  // coefficient with its viscous term. Its fits refine them; before the first, the estimate is the
+  // load cell less that friction instead of the load cell as it is (keys 0.3-4 kN wide in it; 11-16
+  // of 100 corners of the stiff10 and soft10 campaigns and 14 of 79 of the tuning one never fit in
+  // 16-24 s).
   bool calibrator_friction_from_eol = true;
   // ... and holds it as its friction memory's prior of this weight (Calibrator::set_friction_
   // prior: the information of that sum of n_i^2), so that cycles that cannot tell the keys from
