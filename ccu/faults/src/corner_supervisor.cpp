@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace bbw::faults {
 namespace {
@@ -46,10 +47,9 @@ calibration::CalibratorConfig accepting(calibration::CalibratorConfig c, const M
 // The caliper's measured key friction on a calibrator's thresholds: each element's force share
 // K Delta split between the two thresholds around its own in log spacing (beyond the ends: the
 // end one's), returned as the calibrator's K_i (kN/rev).
-std::vector<double> eol_friction_stiffness(const calibration::CalibratorConfig& c, const plant::KeyFrictionParams& k) {
+std::vector<double> eol_friction_stiffness(const calibration::CalibratorConfig& c, const plant::KeyFriction& keys) {
   const std::vector<double> delta = calibration::friction_thresholds_rev(c);  // smallest first
   std::vector<double> share_kN(delta.size(), 0.0);
-  const plant::KeyFriction keys(k);
   const auto& thresholds = keys.thresholds_rev();
   const auto& stiffness = keys.stiffness_kN_per_rev();
   for (std::size_t j = 0; j < thresholds.size() && !delta.empty(); ++j) {
@@ -87,16 +87,18 @@ calibration::CalibratorConfig calibrator_start(calibration::CalibratorConfig c, 
   if (m.calibrator_backlash_from_eol && m.eol_curve && m.eol_backlash_rev > 0.0) {
     c.backlash_width_rev = std::min(m.eol_backlash_rev, model::BacklashTerm::width.max);
   }
+  // The caliper's measured keys, built once for the two items below.
+  const std::optional<plant::KeyFriction> keys =
+      m.eol_key_friction ? std::optional<plant::KeyFriction>(std::in_place, *m.eol_key_friction) : std::nullopt;
   // Elements from the caliper's largest key threshold down (the configured delta_max the most).
-  if (m.calibrator_elements_from_eol && m.eol_key_friction) {
-    const plant::KeyFriction keys(*m.eol_key_friction);
-    const auto& thresholds = keys.thresholds_rev();
+  if (m.calibrator_elements_from_eol && keys) {
+    const auto& thresholds = keys->thresholds_rev();
     const double largest_rev = thresholds.empty() ? 0.0 : *std::max_element(thresholds.begin(), thresholds.end());
     if (largest_rev > 0.0) c.delta_max_rev = std::min(c.delta_max_rev, largest_rev);
   }
   // Its measured keys (and viscous friction) as its start and its fits' prior, on its thresholds.
-  if (m.calibrator_friction_from_eol && m.eol_key_friction && c.elements_M > 0) {
-    c.initial_stiffness_kN_per_rev = eol_friction_stiffness(c, *m.eol_key_friction);
+  if (m.calibrator_friction_from_eol && keys && c.elements_M > 0) {
+    c.initial_stiffness_kN_per_rev = eol_friction_stiffness(c, *keys);
     c.initial_viscous_kN_per_rev_per_s = c.viscous_friction ? m.eol_viscous_kN_per_rev_per_s : 0.0;
     c.initial_friction_weight = m.calibrator_friction_prior_weight;
   }
